@@ -1,0 +1,10 @@
+//! strafeopt: minimal-time strafing paths for Half-Life (GoldSrc) and Half-Life 2 (Source) movement.
+//!
+//! Data flows one way: [`scene`] -> [`sim`] -> [`optimise`] -> [`report`]. [`physics`] is the algebra
+//! layer under all of them; [`geometry`] holds the corridor and the swept player hull.
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod physics;
+
+pub use error::{Error, Result};
