@@ -5,6 +5,8 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod geometry;
 pub mod physics;
+pub mod scene;
 
 pub use error::{Error, Result};
