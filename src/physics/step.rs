@@ -276,7 +276,23 @@ impl<R: Real> Stepper<R> {
     }
 
     /// Steps 1-4 of physics.md section 3: everything before the position update.
+    #[inline]
     pub fn pre_move(&self, s: &mut PlayerState<R>, w: &Wish<R>) {
+        if let Some((a_hat, law)) = self.prepare(s, w) {
+            s.vel = accelerate(s.vel, a_hat, law);
+            if s.on_ground && s.vel.length() < R::from_f64(WALK_STOP_SPEED_UPS) {
+                // PM_WalkMove / WalkMove: a crawl below 1 ups stops dead.
+                s.vel = V2::ZERO;
+            }
+        }
+    }
+
+    /// Steps 1-3 and the clamp of step 4: duck, gravity, jump, friction. Afterwards `s.vel` is `lambda(v)`.
+    /// Returns the wish direction and the acceleration law (physics.md section 5) when an acceleration
+    /// effect applies this frame. The law does not depend on the view direction, so a controller can call
+    /// this on a copy of the state to choose its angle from `lambda(v)`.
+    #[inline]
+    pub fn prepare(&self, s: &mut PlayerState<R>, w: &Wish<R>) -> Option<(V2<R>, AccelLaw<R>)> {
         let fx = self.effects;
         if fx.has(Effect::Duck) {
             self.duck(s, w.duck);
@@ -297,15 +313,10 @@ impl<R: Real> Stepper<R> {
         self.clamp_all(s);
         let (a_hat, m) = self.wish_direction(w, s.ducked, s.on_ground);
         if s.on_ground {
-            if fx.has(Effect::GroundAccel) {
-                s.vel = accelerate(s.vel, a_hat, self.ground_law(m));
-                // PM_WalkMove / WalkMove: a crawl below 1 ups stops dead.
-                if s.vel.length() < R::from_f64(WALK_STOP_SPEED_UPS) {
-                    s.vel = V2::ZERO;
-                }
-            }
-        } else if fx.has(Effect::AirAccel) {
-            s.vel = accelerate(s.vel, a_hat, self.air_law(m));
+            fx.has(Effect::GroundAccel)
+                .then(|| (a_hat, self.ground_law(m)))
+        } else {
+            fx.has(Effect::AirAccel).then(|| (a_hat, self.air_law(m)))
         }
     }
 

@@ -1,1 +1,345 @@
-//! (placeholder: filled in below)
+//! Strafe angles (physics.md sections 5-8). Every function takes `lambda = |lambda(v)|`, the speed after
+//! friction (ups), and the frame's [`AccelLaw`] (`L`, `gamma1`), and works with `cos theta`, where `theta`
+//! is the angle between `lambda(v)` and the wish direction. Speeds depend only on `cos theta`; the sign of
+//! `theta` picks the side. No function divides by a zero speed or takes `acos` of an unclamped value.
+
+use super::step::{AccelLaw, Control, PlayerState, Side, Stepper, Wish};
+use super::vec2::Vec2;
+
+/// Speed after one frame at `cos theta` (the scalar FME, physics.md section 5):
+/// `|v'|^2 = lambda^2 + mu^2 + 2 mu lambda cos theta` with `mu = min(gamma1, L - lambda cos theta)` when
+/// `L - lambda cos theta > 0`, else 0.
+#[inline]
+pub fn speed_after(lambda: f64, cos_theta: f64, law: AccelLaw) -> f64 {
+    let c = lambda * cos_theta;
+    let mu = law.mu(c);
+    (lambda * lambda + mu * mu + 2.0 * mu * c).max(0.0).sqrt()
+}
+
+/// `mu` at `cos theta` (physics.md section 5).
+#[inline]
+pub fn mu_at(lambda: f64, cos_theta: f64, law: AccelLaw) -> f64 {
+    law.mu(lambda * cos_theta)
+}
+
+/// `theta` from `cos theta`, clamped into `[-1, 1]` first.
+#[inline]
+pub fn theta_from_cos(cos_theta: f64) -> f64 {
+    cos_theta.clamp(-1.0, 1.0).acos()
+}
+
+/// Which case of physics.md section 6 a frame falls in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaxAccelCase {
+    /// `gamma1 >= 0`, `L - gamma1 >= 0`, `L >= 0`: `cos Theta = min(1, cos zeta)`.
+    One,
+    /// `gamma1 >= 0`, `L - gamma1 < 0`, `L >= 0`: `cos Theta = 0`.
+    Two,
+    /// `gamma1 >= 0`, `L < 0`: no angle accelerates; any `cos Theta >= cos zeta_bar` keeps the speed.
+    Three,
+    /// `gamma1 < 0`, `cos zeta_bar <= -1`: every angle keeps the speed.
+    Four,
+    /// `gamma1 < 0`, `cos zeta_bar > -1`: `cos Theta = -1`, pushing against the negative gain.
+    Five,
+}
+
+/// The maximum-acceleration choice of one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaxAccel {
+    /// The case of physics.md section 6.
+    pub case: MaxAccelCase,
+    /// The optimal `cos Theta` (for cases 3 and 4, where a range is optimal, 1: keep the heading).
+    pub cos_theta: f64,
+    /// The new speed, ups, by the closed forms of section 6.
+    pub speed: f64,
+}
+
+/// Maximum acceleration (physics.md section 6, all five cases). `lambda` may be zero: the direction is then
+/// lost and `cos Theta` refers to the view direction. `cos zeta = (L - gamma1)/lambda` and
+/// `cos zeta_bar = L/lambda` are compared by multiplying through by `lambda`, never divided by zero.
+pub fn max_accel(lambda: f64, law: AccelLaw) -> MaxAccel {
+    let AccelLaw { l, gamma1 } = law;
+    if gamma1 >= 0.0 {
+        if l >= 0.0 {
+            if l - gamma1 >= 0.0 {
+                // Case 1: min(1, cos zeta).
+                if l - gamma1 >= lambda {
+                    MaxAccel {
+                        case: MaxAccelCase::One,
+                        cos_theta: 1.0,
+                        speed: lambda + gamma1,
+                    }
+                } else {
+                    MaxAccel {
+                        case: MaxAccelCase::One,
+                        cos_theta: (l - gamma1) / lambda,
+                        speed: (lambda * lambda + gamma1 * (2.0 * l - gamma1)).sqrt(),
+                    }
+                }
+            } else {
+                MaxAccel {
+                    case: MaxAccelCase::Two,
+                    cos_theta: 0.0,
+                    speed: lambda.hypot(l),
+                }
+            }
+        } else {
+            MaxAccel {
+                case: MaxAccelCase::Three,
+                cos_theta: 1.0,
+                speed: lambda,
+            }
+        }
+    } else if l <= -lambda {
+        MaxAccel {
+            case: MaxAccelCase::Four,
+            cos_theta: 1.0,
+            speed: lambda,
+        }
+    } else {
+        MaxAccel {
+            case: MaxAccelCase::Five,
+            cos_theta: -1.0,
+            speed: lambda - gamma1,
+        }
+    }
+}
+
+/// The maximum-acceleration angle `Theta` in `[0, pi]`, radians (physics.md section 6).
+#[inline]
+pub fn max_accel_theta(lambda: f64, law: AccelLaw) -> f64 {
+    theta_from_cos(max_accel(lambda, law).cos_theta)
+}
+
+/// The candidate `cos theta` values at which the speed, as a function of `cos theta`, can have its extrema:
+/// the ends `-1, 1`, the piece boundaries `cos zeta` (`gamma1 = gamma2`) and `cos zeta_bar` (`gamma2 = 0`),
+/// each also nudged to both sides (with `gamma1 < 0` the speed jumps at `cos zeta_bar`), and 0. Between
+/// them `|v'|^2` is linear (`mu = gamma1`), concave (`mu = gamma2`) or constant (`mu = 0`), so the
+/// minimum lies at a candidate and the maximum at a candidate or at 0.
+fn extremum_candidates(lambda: f64, law: AccelLaw) -> Vec<f64> {
+    let mut c = vec![-1.0, 0.0, 1.0];
+    if lambda > 0.0 {
+        for b in [(law.l - law.gamma1) / lambda, law.l / lambda] {
+            if b.is_finite() && b > -1.0 && b < 1.0 {
+                let nudge = 1e-12 * (1.0 + b.abs());
+                c.extend([b, (b - nudge).max(-1.0), (b + nudge).min(1.0)]);
+            }
+        }
+    }
+    c
+}
+
+/// Maximum deceleration (physics.md section 7): the `cos theta` that minimises the new speed, and that
+/// speed. In the common case (`gamma1 >= 0`, `L >= 0`, `L - gamma1 >= 0`) it is `cos theta = -1`, giving
+/// `| lambda - gamma1 |`; in general the minimum is found exactly among the piece boundaries.
+pub fn max_decel(lambda: f64, law: AccelLaw) -> (f64, f64) {
+    let mut best = (1.0, speed_after(lambda, 1.0, law));
+    for c in extremum_candidates(lambda, law) {
+        let sp = speed_after(lambda, c, law);
+        if sp < best.1 {
+            best = (c, sp);
+        }
+    }
+    best
+}
+
+/// Speed-preserving strafing (physics.md section 8): the `cos theta` at which the speed after the frame
+/// equals `speed_before` (the speed before friction; equal to `lambda` without friction), turning as hard as
+/// possible (the smallest such `cos theta`), or `None` when no angle preserves it (then fall back to
+/// [`max_accel`], as section 8 says).
+///
+/// Section 8's two formulas are the solutions on the `mu = gamma1` piece,
+/// `cos theta = ((|v|^2 - lambda^2)/gamma1 - gamma1)/(2 lambda)`, and on the `mu = gamma2` piece,
+/// `cos theta = -sqrt(L^2 - (|v|^2 - lambda^2))/lambda`. Each piece of `|v'|^2(cos theta)` is linear,
+/// concave quadratic or constant, so every solution is found exactly; where section 8's formulas apply
+/// this returns the same value, and it also finds the gentler solutions they miss.
+pub fn speed_preserving_cos_theta(speed_before: f64, lambda: f64, law: AccelLaw) -> Option<f64> {
+    let AccelLaw { l, gamma1 } = law;
+    if !(lambda > 0.0 && speed_before.is_finite()) {
+        return None;
+    }
+    let loss = speed_before * speed_before - lambda * lambda; // what friction took, in speed^2
+    // Piece boundaries: gamma2 = gamma1 at cos zeta, gamma2 = 0 at cos zeta_bar.
+    let cos_zeta = (l - gamma1) / lambda;
+    let cos_zeta_bar = l / lambda;
+    let eps = 1e-12;
+    let mut solutions: Vec<f64> = Vec::with_capacity(4);
+    // mu = gamma1 where gamma2 >= gamma1 and gamma2 > 0: |v'|^2 = lambda^2 + gamma1^2 + 2 gamma1 lambda c.
+    if gamma1 != 0.0 {
+        let c = (loss / gamma1 - gamma1) / (2.0 * lambda);
+        if c <= cos_zeta + eps && c < cos_zeta_bar {
+            solutions.push(c);
+        }
+    }
+    // mu = gamma2 where 0 < gamma2 < gamma1: |v'|^2 = lambda^2 (1 - c^2) + L^2.
+    let disc = l * l - loss;
+    if disc >= 0.0 {
+        let r = disc.sqrt() / lambda;
+        for c in [-r, r] {
+            if c >= cos_zeta - eps && c < cos_zeta_bar {
+                solutions.push(c);
+            }
+        }
+    }
+    // mu = 0 where gamma2 <= 0: |v'| = lambda, which preserves only without friction.
+    if loss.abs() <= eps * speed_before * speed_before {
+        solutions.push(cos_zeta_bar);
+    }
+    solutions
+        .into_iter()
+        .filter(|c| c.is_finite() && (-1.0..=1.0).contains(c))
+        .fold(None, |best: Option<f64>, c| Some(best.map_or(c, |b| b.min(c))))
+}
+
+/// The sharpest turn of one frame (physics.md section 9): the `theta` in `[0, pi]` that turns the velocity
+/// furthest, and that turn, radians. The turn at `theta` is `atan2(mu sin theta, lambda + mu cos theta)`.
+/// Where `mu = gamma1` it peaks at `cos theta = -gamma1/lambda`; where `mu = gamma2` it is found by a scan
+/// refined by golden-section search.
+pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
+    let turn = |theta: f64| {
+        let (s, c) = theta.sin_cos();
+        let mu = mu_at(lambda, c, law);
+        (mu * s).atan2(lambda + mu * c)
+    };
+    let mut best = (0.0, turn(0.0));
+    let mut consider = |theta: f64, best: &mut (f64, f64)| {
+        let t = turn(theta);
+        if t > best.1 {
+            *best = (theta, t);
+        }
+    };
+    for c in extremum_candidates(lambda, law) {
+        consider(theta_from_cos(c), &mut best);
+    }
+    if lambda > 0.0 && law.gamma1 > 0.0 {
+        consider(theta_from_cos(-law.gamma1 / lambda), &mut best);
+    }
+    // A scan over theta refined around its best sample (golden section on the bracketing interval).
+    const SCAN: usize = 256;
+    let step = std::f64::consts::PI / SCAN as f64;
+    let mut scan_best = (0.0, f64::NEG_INFINITY);
+    for i in 0..=SCAN {
+        let th = i as f64 * step;
+        let t = turn(th);
+        if t > scan_best.1 {
+            scan_best = (th, t);
+        }
+    }
+    let (mut a, mut b) = (
+        (scan_best.0 - step).max(0.0),
+        (scan_best.0 + step).min(std::f64::consts::PI),
+    );
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..80 {
+        let x1 = b - g * (b - a);
+        let x2 = a + g * (b - a);
+        if turn(x1) >= turn(x2) {
+            b = x2;
+        } else {
+            a = x1;
+        }
+    }
+    consider(0.5 * (a + b), &mut best);
+    consider(scan_best.0, &mut best);
+    best
+}
+
+/// The maximum-acceleration control of this frame for a player holding the keys `forwardmove`, `sidemove`,
+/// turning to `side`: the stepper's own friction and law are applied to a copy of the state, then the yaw is
+/// set so that the wish direction makes the angle [`max_accel_theta`] with `lambda(v)` (physics.md
+/// section 6). `heading_rad` is used at zero speed. The returned control carries the given buttons.
+pub fn max_accel_control(
+    stepper: &Stepper<f64>,
+    state: &PlayerState,
+    keys: Wish,
+    side: Side,
+    heading_rad: f64,
+) -> Control {
+    strafe_control(stepper, state, keys, heading_rad, |lambda, law| {
+        side.sign() * max_accel_theta(lambda, law)
+    })
+}
+
+/// A control whose strafe angle is chosen by `pick_theta(lambda, law)` from the frame's speed after friction
+/// and acceleration law (see [`max_accel_control`]).
+pub fn strafe_control(
+    stepper: &Stepper<f64>,
+    state: &PlayerState,
+    keys: Wish,
+    heading_rad: f64,
+    pick_theta: impl FnOnce(f64, AccelLaw) -> f64,
+) -> Control {
+    let mut probe = *state;
+    let theta = match stepper.prepare(&mut probe, &keys) {
+        Some((_, law)) => pick_theta(probe.vel.length(), law),
+        None => 0.0,
+    };
+    let heading = if probe.vel.length_squared() > 0.0 {
+        probe.vel.angle()
+    } else {
+        heading_rad
+    };
+    let mut c = Control::strafe(
+        probe.vel,
+        heading,
+        theta,
+        keys.forwardmove,
+        keys.sidemove,
+    );
+    c.jump = keys.jump;
+    c.duck = keys.duck;
+    c
+}
+
+/// The keys a strafer holds by default: full sidemove only (`S = 400` in GoldSrc), so `M = min(M_m, 400)`.
+pub fn strafe_keys(side_key_speed: f64) -> Wish {
+    Wish {
+        forward: Vec2::new(1.0, 0.0),
+        forwardmove: 0.0,
+        sidemove: side_key_speed,
+        jump: false,
+        duck: false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn law(l: f64, gamma1: f64) -> AccelLaw {
+        AccelLaw { l, gamma1 }
+    }
+
+    #[test]
+    fn case_formulas_match_the_scalar_fme_at_the_chosen_angle() {
+        for &(lam, l, g) in &[
+            (500.0, 30.0, 3.2),   // case 1, cos zeta < 1
+            (10.0, 30.0, 3.2),    // case 1, cos = 1
+            (500.0, 30.0, 32.0),  // case 2
+            (500.0, -5.0, 3.0),   // case 3
+            (500.0, -600.0, -1.0), // case 4
+            (500.0, 30.0, -2.0),  // case 5
+            (0.0, 30.0, 3.2),     // zero speed
+            (0.0, 30.0, 32.0),
+            (0.0, 0.0, 0.0),
+        ] {
+            let m = max_accel(lam, law(l, g));
+            let direct = speed_after(lam, m.cos_theta, law(l, g));
+            assert!((m.speed - direct).abs() < 1e-9, "{lam} {l} {g}: {m:?} vs {direct}");
+            assert!(m.speed.is_finite() && m.cos_theta.abs() <= 1.0);
+        }
+    }
+
+    #[test]
+    fn speed_preserving_keeps_the_speed_without_friction() {
+        let l = law(30.0, 3.2);
+        let c = speed_preserving_cos_theta(500.0, 500.0, l).unwrap_or(2.0);
+        assert!((c + 3.2 / 1000.0).abs() < 1e-15);
+        assert!((speed_after(500.0, c, l) - 500.0).abs() < 1e-9);
+        // gamma1 > 2L: cos theta = -L/|v|.
+        let l = law(30.0, 64.0);
+        let c = speed_preserving_cos_theta(500.0, 500.0, l).unwrap_or(2.0);
+        assert!((c + 30.0 / 500.0).abs() < 1e-15);
+        assert!((speed_after(500.0, c, l) - 500.0).abs() < 1e-9);
+    }
+}
