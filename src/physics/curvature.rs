@@ -1,1 +1,167 @@
-//! (placeholder: filled in below)
+//! Curvature and the radius-speed relation (physics.md section 9).
+//!
+//! Two radii are kept apart on purpose. The source text's relation
+//! `r = (tau / sin theta)(2|v|^2/mu + 3|v| cos theta + mu)` gives about twice the radius of the path the
+//! game actually draws; the first-order radius `tau |v'|^2 / (mu sin theta)` and the circle through three
+//! simulated positions agree with each other. Corners are planned with the measured one.
+
+use super::closed_form::strafing_effects;
+use super::step::{AccelLaw, PlayerState, Side, Stepper};
+use super::strafe::{max_accel, max_accel_control, mu_at, strafe_keys};
+use super::vars::MovementVars;
+use super::vec2::Vec2;
+use crate::error::{Error, Result};
+
+/// The player hull's width, units (32 x 32 footprint).
+pub const HULL_WIDTH_UNITS: f64 = 32.0;
+
+/// Largest arc through a 90-degree bend of equal width `d` before and after, touching both outer walls and
+/// the inner corner: `r = (2 + sqrt 2) d` (physics.md section 9). Pass the width left for the hull centre.
+pub fn bend_arc_radius(width_for_centre: f64) -> f64 {
+    (2.0 + std::f64::consts::SQRT_2) * width_for_centre
+}
+
+/// The source text's radius of the path over one frame (physics.md section 9):
+/// `r = (tau / sin theta)(2|v|^2/mu + 3|v| cos theta + mu)`. Infinite when `sin theta` or `mu` is zero.
+pub fn radius_source_text(speed: f64, cos_theta: f64, mu: f64, tau_s: f64) -> f64 {
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    if sin_theta <= 0.0 || mu <= 0.0 {
+        return f64::INFINITY;
+    }
+    (tau_s / sin_theta) * (2.0 * speed * speed / mu + 3.0 * speed * cos_theta + mu)
+}
+
+/// The first-order radius of the discrete path (physics.md section 9): the velocity turns by about
+/// `mu sin theta / |v'|` per frame over a chord of `tau |v'|`, so `r = tau |v'|^2 / (mu sin theta)`.
+pub fn radius_first_order(speed_after: f64, cos_theta: f64, mu: f64, tau_s: f64) -> f64 {
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    if sin_theta <= 0.0 || mu <= 0.0 {
+        return f64::INFINITY;
+    }
+    tau_s * speed_after * speed_after / (mu * sin_theta)
+}
+
+/// Radius of the circle through three points (infinite when they are collinear).
+pub fn circumradius(a: Vec2, b: Vec2, c: Vec2) -> f64 {
+    let (ab, bc, ca) = ((b - a).length(), (c - b).length(), (a - c).length());
+    let twice_area = (b - a).cross(c - a).abs();
+    if twice_area <= 0.0 {
+        return f64::INFINITY;
+    }
+    ab * bc * ca / (2.0 * twice_area)
+}
+
+/// The airstrafing law of `vars` (full strafe key, airborne): `L = min(30, M)`, `gamma1 = k_e tau M A`.
+pub fn air_law(vars: &MovementVars) -> AccelLaw {
+    let m = vars.maxspeed.min(vars.side_key_speed);
+    AccelLaw {
+        l: m.min(vars.air_speed_cap),
+        gamma1: vars.entity_friction * vars.frame_time_s() * m * vars.airaccelerate,
+    }
+}
+
+/// All the radii of maximum-acceleration airstrafing at `speed` ups.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaxAccelRadii {
+    /// The maximum-acceleration angle, radians.
+    pub theta_rad: f64,
+    /// `mu` at that angle, ups.
+    pub mu: f64,
+    /// The source text's relation (type 1 or type 2 of section 9, whichever case applies).
+    pub source_text: f64,
+    /// The first-order radius `tau |v'|^2 / (mu sin theta)`.
+    pub first_order: f64,
+    /// The circle through the positions at 0, tau, 2 tau of a simulated run.
+    pub measured: f64,
+}
+
+/// The radii of maximum-acceleration airstrafing at `speed` (physics.md section 9).
+pub fn max_accel_radii(vars: &MovementVars, speed: f64) -> MaxAccelRadii {
+    let law = air_law(vars);
+    let tau = vars.frame_time_s();
+    let m = max_accel(speed, law);
+    let mu = mu_at(speed, m.cos_theta, law);
+    MaxAccelRadii {
+        theta_rad: m.cos_theta.clamp(-1.0, 1.0).acos(),
+        mu,
+        source_text: radius_source_text(speed, m.cos_theta, mu, tau),
+        first_order: radius_first_order(m.speed, m.cos_theta, mu, tau),
+        measured: measured_radius(vars, speed),
+    }
+}
+
+/// The radius of the circle through the positions at 0, tau and 2 tau of maximum-acceleration airstrafing
+/// from `speed` ups, simulated frame by frame (no velocity clamp).
+pub fn measured_radius(vars: &MovementVars, speed: f64) -> f64 {
+    let fx = strafing_effects(false, false);
+    let stepper: Stepper<f64> = Stepper::new(vars, fx);
+    let keys = strafe_keys(vars.side_key_speed);
+    let mut s = PlayerState::airborne(Vec2::ZERO, Vec2::new(speed, 0.0));
+    let mut pts = [Vec2::ZERO; 3];
+    for p in pts.iter_mut() {
+        *p = s.pos;
+        let c = max_accel_control(&stepper, &s, keys, Side::Left, 0.0);
+        stepper.step(&mut s, &c.wish());
+    }
+    circumradius(pts[0], pts[1], pts[2])
+}
+
+/// The speed whose measured maximum-acceleration radius is `radius` units, by bisection (the radius grows
+/// monotonically with speed). Errors when `radius` is beyond what speeds up to `sv_maxvelocity` draw.
+pub fn speed_for_radius(vars: &MovementVars, radius: f64) -> Result<f64> {
+    invert_monotone(|v| measured_radius(vars, v), radius, vars.maxvelocity)
+}
+
+/// The speed whose radius by the source text's relation is `radius` (type 2 in closed form
+/// `|v| = sqrt((L/2)(r/tau - L))`, type 1 by bisection).
+pub fn speed_for_radius_source_text(vars: &MovementVars, radius: f64) -> Result<f64> {
+    let law = air_law(vars);
+    let tau = vars.frame_time_s();
+    if law.gamma1 >= law.l && law.l > 0.0 {
+        let v2 = 0.5 * law.l * (radius / tau - law.l);
+        if v2 < 0.0 {
+            return Err(Error::Unreachable {
+                what: format!("radius {radius} is below the smallest the relation gives, tau L = {}", tau * law.l),
+            });
+        }
+        return Ok(v2.sqrt());
+    }
+    invert_monotone(
+        |v| {
+            let m = max_accel(v, law);
+            radius_source_text(v, m.cos_theta, mu_at(v, m.cos_theta, law), tau)
+        },
+        radius,
+        vars.maxvelocity,
+    )
+}
+
+/// Solves `f(v) = target` for `v` in `(0, v_max]` by bisection, `f` increasing.
+fn invert_monotone(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Result<f64> {
+    let (mut lo, mut hi) = (1e-6, v_max);
+    if !(f(hi) >= target) {
+        return Err(Error::Unreachable {
+            what: format!(
+                "radius {target} needs more than sv_maxvelocity = {v_max} ups (radius there {:.3})",
+                f(hi)
+            ),
+        });
+    }
+    if f(lo) > target {
+        return Err(Error::Unreachable {
+            what: format!("radius {target} is tighter than any speed draws (at 0 ups: {:.6})", f(lo)),
+        });
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= 1e-12 * hi {
+            break;
+        }
+    }
+    Ok(0.5 * (lo + hi))
+}

@@ -202,7 +202,7 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
         (mu * s).atan2(lambda + mu * c)
     };
     let mut best = (0.0, turn(0.0));
-    let mut consider = |theta: f64, best: &mut (f64, f64)| {
+    let consider = |theta: f64, best: &mut (f64, f64)| {
         let t = turn(theta);
         if t > best.1 {
             *best = (theta, t);
