@@ -4,6 +4,7 @@
 //! layer under all of them; [`geometry`] holds the corridor and the swept player hull.
 #![warn(missing_docs)]
 
+pub mod cli;
 pub mod error;
 pub mod geometry;
 pub mod physics;

@@ -136,9 +136,35 @@ pub fn speed_for_radius_source_text(vars: &MovementVars, radius: f64) -> Result<
     )
 }
 
-/// Solves `f(v) = target` for `v` in `(0, v_max]` by bisection, `f` increasing.
+/// Solves `f(v) = target` for `v` in `(0, v_max]` on the branch where `f` increases. Below `L - gamma1`
+/// maximum acceleration goes straight ahead (infinite radius), so the radius first falls with speed and then
+/// rises: the smallest radius is located by a log-spaced scan refined by golden section, and the target is
+/// bracketed above it.
 fn invert_monotone(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Result<f64> {
-    let (mut lo, mut hi) = (1e-6, v_max);
+    const SCAN: usize = 400;
+    let v_min_scan = 1e-3_f64;
+    let ratio = (v_max / v_min_scan).powf(1.0 / SCAN as f64);
+    let mut best = (v_max, f(v_max));
+    let mut v = v_min_scan;
+    for _ in 0..=SCAN {
+        let r = f(v);
+        if r < best.1 {
+            best = (v, r);
+        }
+        v *= ratio;
+    }
+    let (mut a, mut b) = ((best.0 / ratio).max(v_min_scan), (best.0 * ratio).min(v_max));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..100 {
+        let (x1, x2) = (b - g * (b - a), a + g * (b - a));
+        if f(x1) <= f(x2) {
+            b = x2;
+        } else {
+            a = x1;
+        }
+    }
+    let (mut lo, mut hi) = (0.5 * (a + b), v_max);
+    let smallest = f(lo);
     if !(f(hi) >= target) {
         return Err(Error::Unreachable {
             what: format!(
@@ -147,9 +173,11 @@ fn invert_monotone(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Result<f6
             ),
         });
     }
-    if f(lo) > target {
+    if smallest > target {
         return Err(Error::Unreachable {
-            what: format!("radius {target} is tighter than any speed draws (at 0 ups: {:.6})", f(lo)),
+            what: format!(
+                "radius {target} is tighter than maximum acceleration ever turns (smallest {smallest:.4} at {lo:.4} ups)"
+            ),
         });
     }
     for _ in 0..200 {

@@ -1,0 +1,160 @@
+//! Command-line arguments (stage one of two, as in ripgrep): clap types that mirror the flags and validate
+//! only what was typed. [`super::calc`] resolves them into library values; the library never sees clap.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// strafeopt: minimal-time strafing paths for Half-Life and Half-Life 2 movement.
+#[derive(Debug, Parser)]
+#[command(name = "strafeopt", version, about, propagate_version = true)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Figures from the physics reference: closed forms beside frame-by-frame simulation.
+    Calc(CalcArgs),
+}
+
+/// `strafeopt calc FORM ...`
+#[derive(Debug, Args)]
+pub struct CalcArgs {
+    /// Which figure.
+    #[command(subcommand)]
+    pub form: CalcForm,
+}
+
+/// The `calc` forms (the flattened `engine`/`output` fields are the common flags).
+#[allow(missing_docs)]
+#[derive(Debug, Subcommand)]
+pub enum CalcForm {
+    /// Frames of maximum-acceleration strafing from one speed to another (closed form and stepping).
+    FramesToSpeed {
+        /// Start speed, ups.
+        #[arg(long, allow_negative_numbers = true)]
+        from: f64,
+        /// Target speed, ups.
+        #[arg(long, allow_negative_numbers = true)]
+        to: f64,
+        /// Groundstrafe (friction, ground acceleration) instead of airstrafe.
+        #[arg(long)]
+        ground: bool,
+        #[command(flatten)]
+        engine: EngineFlags,
+        #[command(flatten)]
+        output: OutputFlags,
+    },
+    /// The steady groundstrafe speed (closed form and simulated until it settles).
+    MaxGroundSpeed {
+        /// Apply edge friction (`e_f`, 2 by default).
+        #[arg(long)]
+        edge_friction: bool,
+        #[command(flatten)]
+        engine: EngineFlags,
+        #[command(flatten)]
+        output: OutputFlags,
+    },
+    /// Turn radius of maximum-acceleration airstrafing at a speed: the source text's relation and the
+    /// circle through three simulated positions.
+    Radius {
+        /// Speed, ups.
+        #[arg(long, allow_negative_numbers = true)]
+        speed: f64,
+        #[command(flatten)]
+        engine: EngineFlags,
+        #[command(flatten)]
+        output: OutputFlags,
+    },
+    /// The speed whose maximum-acceleration turn has a given radius (root finder on the measured relation).
+    SpeedForRadius {
+        /// Radius, units.
+        #[arg(long, allow_negative_numbers = true)]
+        radius: f64,
+        #[command(flatten)]
+        engine: EngineFlags,
+        #[command(flatten)]
+        output: OutputFlags,
+    },
+    /// Largest arc through a 90-degree bend of a given width, (2 + sqrt 2)(D - hull width), and its speed.
+    Bend {
+        /// Corridor width D, units.
+        #[arg(long, allow_negative_numbers = true)]
+        width: f64,
+        #[command(flatten)]
+        engine: EngineFlags,
+        #[command(flatten)]
+        output: OutputFlags,
+    },
+    /// The accelerated-backhop article's per-hop table and the time the line is crossed.
+    Abh {
+        /// Max speed Mx, ups (150 without the suit).
+        #[arg(long, default_value_t = 150.0, allow_negative_numbers = true)]
+        max_speed: f64,
+        /// Time of one hop, seconds (GAMEMOVEMENT_JUMP_TIME).
+        #[arg(long, default_value_t = 0.51, allow_negative_numbers = true)]
+        hop_time: f64,
+        /// Distance to the line, units (100 m = 5249.34).
+        #[arg(long, default_value_t = 5249.34, allow_negative_numbers = true)]
+        distance: f64,
+        #[command(flatten)]
+        engine: EngineFlags,
+        #[command(flatten)]
+        output: OutputFlags,
+    },
+}
+
+/// Engine presets on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PresetArg {
+    /// Half-Life defaults (1000 fps unless --fps).
+    Goldsrc,
+    /// Half-Life 2 defaults (66.67 ticks/s unless --fps).
+    #[value(name = "source-hl2")]
+    SourceHl2,
+}
+
+/// The movement variables common to every form.
+#[derive(Debug, Args, Clone, Default)]
+pub struct EngineFlags {
+    /// Engine defaults to start from.
+    #[arg(long, value_enum)]
+    pub preset: Option<PresetArg>,
+    /// Frames per second (frame time 1/fps).
+    #[arg(long, allow_negative_numbers = true)]
+    pub fps: Option<f64>,
+    /// sv_accelerate.
+    #[arg(long, allow_negative_numbers = true)]
+    pub accelerate: Option<f64>,
+    /// sv_airaccelerate.
+    #[arg(long, allow_negative_numbers = true)]
+    pub airaccelerate: Option<f64>,
+    /// sv_maxspeed, ups.
+    #[arg(long, allow_negative_numbers = true)]
+    pub maxspeed: Option<f64>,
+    /// sv_friction.
+    #[arg(long, allow_negative_numbers = true)]
+    pub friction: Option<f64>,
+    /// sv_stopspeed, ups.
+    #[arg(long, allow_negative_numbers = true)]
+    pub stopspeed: Option<f64>,
+    /// sv_maxvelocity, ups (each component).
+    #[arg(long, allow_negative_numbers = true)]
+    pub maxvelocity: Option<f64>,
+    /// sv_gravity, ups per second.
+    #[arg(long, allow_negative_numbers = true)]
+    pub gravity: Option<f64>,
+    /// Entity (surface) friction k_e.
+    #[arg(long, allow_negative_numbers = true)]
+    pub entity_friction: Option<f64>,
+}
+
+/// Output format.
+#[derive(Debug, Args, Clone, Copy, Default)]
+pub struct OutputFlags {
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}

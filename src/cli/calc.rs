@@ -1,0 +1,390 @@
+//! `strafeopt calc`: resolves the flags into movement variables (stage two) and computes each figure with
+//! the library, the closed form beside the simulation.
+
+use super::args::{CalcForm, EngineFlags, PresetArg};
+use crate::error::{require_non_negative, require_positive, Error, Result};
+use crate::physics::closed_form::{
+    airstrafe_frames_to_speed, frames_to_speed_by_stepping, groundstrafe_frames_to_speed,
+    max_groundstrafe_speed, max_groundstrafe_speed_by_stepping,
+};
+use crate::physics::curvature::{
+    air_law, bend_arc_radius, max_accel_radii, speed_for_radius, speed_for_radius_source_text,
+    HULL_WIDTH_UNITS,
+};
+use crate::physics::{abh, AccelLaw, MovementVars, Preset, VarOverrides};
+use serde_json::{json, Value};
+
+/// Most frames `frames-to-speed` steps before it trusts the closed form alone.
+const MAX_STEPPED_FRAMES: f64 = 5e7;
+/// Largest change per frame, ups, at which the simulated groundstrafe speed counts as settled.
+const SETTLE_TOL_UPS: f64 = 1e-10;
+/// Frame cap for settling.
+const MAX_SETTLE_FRAMES: u64 = 50_000_000;
+
+/// A computed figure: the JSON object and its text form.
+pub struct Figures {
+    /// The JSON object (`--json`).
+    pub json: Value,
+    /// Lines for people.
+    pub text: String,
+}
+
+/// Default frames per second of a preset: 1000 for Half-Life (the usual TAS rate), 66.67 for Half-Life 2
+/// (its 0.015 s tick).
+fn default_fps(preset: Preset) -> f64 {
+    match preset {
+        Preset::GoldSrc => 1000.0,
+        Preset::SourceHl2 => 200.0 / 3.0,
+    }
+}
+
+/// The movement variables from the flags, validated; `default` is the preset when `--preset` is absent.
+pub fn resolve_vars(flags: &EngineFlags, default: Preset) -> Result<MovementVars> {
+    let preset = match flags.preset {
+        Some(PresetArg::Goldsrc) => Preset::GoldSrc,
+        Some(PresetArg::SourceHl2) => Preset::SourceHl2,
+        None => default,
+    };
+    let overrides = VarOverrides {
+        fps: flags.fps,
+        accelerate: flags.accelerate,
+        airaccelerate: flags.airaccelerate,
+        maxspeed: flags.maxspeed,
+        friction: flags.friction,
+        stopspeed: flags.stopspeed,
+        maxvelocity: flags.maxvelocity,
+        gravity: flags.gravity,
+        entity_friction: flags.entity_friction,
+        ..VarOverrides::default()
+    };
+    overrides
+        .apply(MovementVars::preset(preset, default_fps(preset)))
+        .map_err(|e| match e {
+            Error::InvalidValue {
+                name,
+                value,
+                allowed,
+            } => Error::InvalidValue {
+                name: format!("--{name}"),
+                value,
+                allowed,
+            },
+            other => other,
+        })
+}
+
+fn inputs(vars: &MovementVars, preset_name: &str) -> Value {
+    json!({
+        "preset": preset_name,
+        "fps": vars.fps,
+        "frame_time": vars.frame_time_s(),
+        "maxspeed": vars.maxspeed,
+        "accelerate": vars.accelerate,
+        "airaccelerate": vars.airaccelerate,
+        "friction": vars.friction,
+        "edgefriction": vars.edgefriction,
+        "entity_friction": vars.entity_friction,
+        "stopspeed": vars.stopspeed,
+        "maxvelocity": vars.maxvelocity,
+        "gravity": vars.gravity,
+    })
+}
+
+fn preset_name(flags: &EngineFlags, default: Preset) -> &'static str {
+    match flags.preset {
+        Some(PresetArg::Goldsrc) => Preset::GoldSrc.name(),
+        Some(PresetArg::SourceHl2) => Preset::SourceHl2.name(),
+        None => default.name(),
+    }
+}
+
+fn finite(name: &str, v: f64) -> Result<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Error::Numerical(format!("{name} came out as {v}")))
+    }
+}
+
+/// Runs one `calc` form.
+pub fn run(form: &CalcForm) -> Result<Figures> {
+    match form {
+        CalcForm::FramesToSpeed {
+            from,
+            to,
+            ground,
+            engine,
+            ..
+        } => frames_to_speed(engine, *from, *to, *ground),
+        CalcForm::MaxGroundSpeed {
+            edge_friction,
+            engine,
+            ..
+        } => max_ground_speed(engine, *edge_friction),
+        CalcForm::Radius { speed, engine, .. } => radius(engine, *speed),
+        CalcForm::SpeedForRadius { radius, engine, .. } => speed_for(engine, *radius),
+        CalcForm::Bend { width, engine, .. } => bend(engine, *width),
+        CalcForm::Abh {
+            max_speed,
+            hop_time,
+            distance,
+            engine,
+            ..
+        } => abh_table(engine, *max_speed, *hop_time, *distance),
+    }
+}
+
+/// True when the form asked for `--json`.
+pub fn wants_json(form: &CalcForm) -> bool {
+    match form {
+        CalcForm::FramesToSpeed { output, .. }
+        | CalcForm::MaxGroundSpeed { output, .. }
+        | CalcForm::Radius { output, .. }
+        | CalcForm::SpeedForRadius { output, .. }
+        | CalcForm::Bend { output, .. }
+        | CalcForm::Abh { output, .. } => output.json,
+    }
+}
+
+fn ground_law(vars: &MovementVars) -> AccelLaw {
+    let m = vars.maxspeed.min(vars.side_key_speed);
+    AccelLaw {
+        l: m,
+        gamma1: vars.entity_friction * vars.frame_time_s() * m * vars.accelerate,
+    }
+}
+
+fn frames_to_speed(engine: &EngineFlags, from: f64, to: f64, ground: bool) -> Result<Figures> {
+    let vars = resolve_vars(engine, Preset::GoldSrc)?;
+    require_non_negative("--from", from)?;
+    require_non_negative("--to", to)?;
+    let reachable = vars.maxvelocity * std::f64::consts::SQRT_2;
+    if to > reachable {
+        return Err(Error::invalid(
+            "--to",
+            to,
+            format!("at most sv_maxvelocity * sqrt 2 = {reachable:.4} ups (the per-component clamp)"),
+        ));
+    }
+    let closed = if ground {
+        groundstrafe_frames_to_speed(
+            from,
+            to,
+            ground_law(&vars),
+            vars.frame_time_s(),
+            vars.friction_k(false),
+            vars.stopspeed,
+        )
+    } else {
+        airstrafe_frames_to_speed(from, to, air_law(&vars))
+    };
+    if ground {
+        let limit = max_groundstrafe_speed(&vars, false);
+        if to >= limit {
+            return Err(Error::invalid(
+                "--to",
+                to,
+                format!("below the maximum groundstrafe speed {limit:.4} ups (--ground)"),
+            ));
+        }
+    }
+    let (frames, method) = match closed {
+        Some(n) if n > MAX_STEPPED_FRAMES => (n.ceil() as u64, "closed-form"),
+        _ => (
+            frames_to_speed_by_stepping(&vars, from, to, ground, (MAX_STEPPED_FRAMES * 2.0) as u64)?,
+            "stepping",
+        ),
+    };
+    let tau = vars.frame_time_s();
+    let kind = if ground { "groundstrafe" } else { "airstrafe" };
+    let closed_text = match closed {
+        Some(n) => format!("{n:.2}"),
+        None => "none (outside the closed form's regime)".to_string(),
+    };
+    Ok(Figures {
+        json: json!({
+            "form": "frames-to-speed",
+            "frames": frames,
+            "frames_method": method,
+            "frames_closed_form": closed,
+            "time": frames as f64 * tau,
+            "from": from,
+            "to": to,
+            "ground": ground,
+            "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
+        }),
+        text: format!(
+            "{kind} {from} -> {to} ups at {} fps\nframes:             {frames} (by {method})\n\
+             frames closed form: {closed_text}\ntime:               {:.4} s\n",
+            vars.fps,
+            frames as f64 * tau
+        ),
+    })
+}
+
+fn max_ground_speed(engine: &EngineFlags, edge: bool) -> Result<Figures> {
+    let vars = resolve_vars(engine, Preset::GoldSrc)?;
+    let speed = max_groundstrafe_speed(&vars, edge);
+    if !speed.is_finite() || vars.friction_k(edge) <= 0.0 {
+        return Err(Error::invalid(
+            "--friction",
+            vars.friction_k(edge),
+            "such that k = sv_friction * k_e * e_f is above 0 (no steady state otherwise)",
+        ));
+    }
+    let (simulated, frames) =
+        max_groundstrafe_speed_by_stepping(&vars, edge, SETTLE_TOL_UPS, MAX_SETTLE_FRAMES);
+    let simulated = finite("simulated speed", simulated)?;
+    Ok(Figures {
+        json: json!({
+            "form": "max-ground-speed",
+            "speed": speed,
+            "speed_simulated": simulated,
+            "frames_to_settle": frames,
+            "edge_friction": edge,
+            "friction_k": vars.friction_k(edge),
+            "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
+        }),
+        text: format!(
+            "maximum groundstrafe speed at {} fps{}\nspeed (closed form): {speed:.4} ups\n\
+             speed (simulated):   {simulated:.4} ups after {frames} frames\n",
+            vars.fps,
+            if edge { ", edge friction" } else { "" }
+        ),
+    })
+}
+
+fn radius(engine: &EngineFlags, speed: f64) -> Result<Figures> {
+    let vars = resolve_vars(engine, Preset::GoldSrc)?;
+    require_positive("--speed", speed)?;
+    let r = max_accel_radii(&vars, speed);
+    let source = finite("radius", r.source_text)?;
+    let measured = finite("radius_measured", r.measured)?;
+    Ok(Figures {
+        json: json!({
+            "form": "radius",
+            "radius": source,
+            "radius_measured": measured,
+            "radius_first_order": r.first_order,
+            "ratio": source / measured,
+            "speed": speed,
+            "theta_deg": r.theta_rad.to_degrees(),
+            "mu": r.mu,
+            "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
+        }),
+        text: format!(
+            "maximum-acceleration airstrafe at {speed} ups, {} fps (theta {:.4} deg, mu {:.4})\n\
+             radius (source text's relation): {source:.4} units\n\
+             radius (circle through 3 simulated positions): {measured:.4} units\n\
+             radius (first order tau v'^2/(mu sin theta)): {:.4} units\n\
+             the relation gives {:.3} times the measured radius (physics.md section 9)\n",
+            vars.fps,
+            r.theta_rad.to_degrees(),
+            r.mu,
+            r.first_order,
+            source / measured
+        ),
+    })
+}
+
+fn speed_for(engine: &EngineFlags, radius: f64) -> Result<Figures> {
+    let vars = resolve_vars(engine, Preset::GoldSrc)?;
+    require_positive("--radius", radius)?;
+    let measured = speed_for_radius(&vars, radius).map_err(|e| flag_unreachable("--radius", radius, e))?;
+    let source = speed_for_radius_source_text(&vars, radius).ok();
+    Ok(Figures {
+        json: json!({
+            "form": "speed-for-radius",
+            "speed": measured,
+            "speed_source_text": source,
+            "radius": radius,
+            "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
+        }),
+        text: format!(
+            "speed whose maximum-acceleration turn has radius {radius} units at {} fps\n\
+             speed (measured relation): {measured:.4} ups\nspeed (source text's relation): {}\n",
+            vars.fps,
+            source.map_or("none".to_string(), |s| format!("{s:.4} ups"))
+        ),
+    })
+}
+
+fn flag_unreachable(flag: &str, value: f64, e: Error) -> Error {
+    match e {
+        Error::Unreachable { what } => Error::invalid(flag, value, format!("reachable: {what}")),
+        other => other,
+    }
+}
+
+fn bend(engine: &EngineFlags, width: f64) -> Result<Figures> {
+    let vars = resolve_vars(engine, Preset::GoldSrc)?;
+    if !(width.is_finite() && width > HULL_WIDTH_UNITS) {
+        return Err(Error::invalid(
+            "--width",
+            width,
+            format!("a finite number above {HULL_WIDTH_UNITS} (the hull width)"),
+        ));
+    }
+    let d = width - HULL_WIDTH_UNITS;
+    let r = bend_arc_radius(d);
+    let speed = speed_for_radius(&vars, r).map_err(|e| flag_unreachable("--width", width, e))?;
+    let source = speed_for_radius_source_text(&vars, r).ok();
+    Ok(Figures {
+        json: json!({
+            "form": "bend",
+            "radius": r,
+            "speed": speed,
+            "speed_source_text": source,
+            "width": width,
+            "width_for_centre": d,
+            "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
+        }),
+        text: format!(
+            "90-degree bend of width {width} units ({d} for the hull centre) at {} fps\n\
+             largest arc radius (2 + sqrt 2) d: {r:.4} units\n\
+             speed on it (measured relation): {speed:.4} ups\nspeed (source text's relation): {}\n",
+            vars.fps,
+            source.map_or("none".to_string(), |s| format!("{s:.4} ups"))
+        ),
+    })
+}
+
+fn abh_table(engine: &EngineFlags, max_speed: f64, hop_time: f64, distance: f64) -> Result<Figures> {
+    let vars = resolve_vars(engine, Preset::SourceHl2)?;
+    require_positive("--max-speed", max_speed)?;
+    require_positive("--hop-time", hop_time)?;
+    require_positive("--distance", distance)?;
+    let a = abh::article_model(max_speed, hop_time, distance, vars.maxvelocity);
+    let crossing = finite("crossing_time", a.crossing_time)?;
+    let mut text = format!(
+        "accelerated backhopping, the article's model: Mx = {max_speed}, hop time {hop_time} s, \
+         sv_maxvelocity {}\n  hop     time (s)   distance (units)   speed (ups)\n",
+        vars.maxvelocity
+    );
+    for (i, h) in a.hops.iter().enumerate() {
+        text.push_str(&format!(
+            "  {:>3}   {:>8.2}   {:>16.2}   {:>11.2}\n",
+            i + 1,
+            h.time,
+            h.distance,
+            h.speed
+        ));
+    }
+    text.push_str(&format!(
+        "line at {distance} units crossed {crossing:.3} s after the first jump; the hop lands {:.2} units past it\n",
+        a.landing_past_line
+    ));
+    Ok(Figures {
+        json: json!({
+            "form": "abh",
+            "hops": a.hops,
+            "crossing_time": crossing,
+            "landing_past_line": a.landing_past_line,
+            "max_speed": max_speed,
+            "hop_time": hop_time,
+            "distance": distance,
+            "inputs": inputs(&vars, preset_name(engine, Preset::SourceHl2)),
+        }),
+        text,
+    })
+}

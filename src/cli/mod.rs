@@ -1,0 +1,91 @@
+//! The command line: a thin layer over the library. Parses arguments, resolves them into library values,
+//! prints the result, and maps errors to exit codes: 0 done, 2 bad input (usage, file, value), 3 no valid
+//! path through the scene, 1 anything else. Every error is one line on stderr behind `strafeopt: `.
+
+pub mod args;
+pub mod calc;
+
+use crate::error::Error;
+use args::{Cli, Command};
+use clap::Parser;
+use std::io::Write;
+
+/// Exit code for success.
+pub const EXIT_OK: u8 = 0;
+/// Exit code for anything unexpected.
+pub const EXIT_FAILURE: u8 = 1;
+/// Exit code for bad input: usage, a file, a value.
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit code when no valid path goes through the scene.
+pub const EXIT_NO_PATH: u8 = 3;
+
+/// The exit code for a library error.
+pub fn exit_code(e: &Error) -> u8 {
+    match e {
+        Error::InvalidValue { .. } | Error::Scene { .. } | Error::Unreachable { .. } => EXIT_BAD_INPUT,
+        Error::NoValidPath(_) => EXIT_NO_PATH,
+        _ => EXIT_FAILURE,
+    }
+}
+
+/// Runs the program on `argv` and returns the exit code.
+pub fn main_with_args(argv: impl IntoIterator<Item = std::ffi::OsString>) -> u8 {
+    let cli = match Cli::try_parse_from(argv) {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+                let _ = e.print();
+                return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                    EXIT_BAD_INPUT
+                } else {
+                    EXIT_OK
+                };
+            }
+            // One line: clap's message up to its usage block, without the "error: " prefix.
+            let rendered = e.render().to_string();
+            let message: Vec<&str> = rendered
+                .lines()
+                .map(str::trim)
+                .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("tip:"))
+                .filter(|l| !l.is_empty())
+                .collect();
+            let line = message.join(" ");
+            let line = line.trim_start_matches("error: ");
+            eprintln!("strafeopt: {line} (see --help)");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    match run(&cli) {
+        Ok(out) => {
+            let mut stdout = std::io::stdout().lock();
+            match stdout.write_all(out.as_bytes()).and_then(|_| stdout.flush()) {
+                Ok(()) => EXIT_OK,
+                // A closed pipe (`| head`) is not a failure.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => EXIT_OK,
+                Err(e) => {
+                    eprintln!("strafeopt: writing the output: {e}");
+                    EXIT_FAILURE
+                }
+            }
+        }
+        Err(e) => {
+            eprintln!("strafeopt: {e}");
+            exit_code(&e)
+        }
+    }
+}
+
+/// Runs a parsed command and returns what to print.
+pub fn run(cli: &Cli) -> Result<String, Error> {
+    match &cli.command {
+        Command::Calc(c) => {
+            let figures = calc::run(&c.form)?;
+            if calc::wants_json(&c.form) {
+                Ok(format!("{}\n", figures.json))
+            } else {
+                Ok(figures.text)
+            }
+        }
+    }
+}
