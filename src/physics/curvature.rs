@@ -121,7 +121,10 @@ pub fn speed_for_radius_source_text(vars: &MovementVars, radius: f64) -> Result<
         let v2 = 0.5 * law.l * (radius / tau - law.l);
         if v2 < 0.0 {
             return Err(Error::Unreachable {
-                what: format!("radius {radius} is below the smallest the relation gives, tau L = {}", tau * law.l),
+                what: format!(
+                    "radius {radius} is below the smallest the relation gives, tau L = {}",
+                    tau * law.l
+                ),
             });
         }
         return Ok(v2.sqrt());
@@ -153,7 +156,10 @@ fn invert_monotone(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Result<f6
         }
         v *= ratio;
     }
-    let (mut a, mut b) = ((best.0 / ratio).max(v_min_scan), (best.0 * ratio).min(v_max));
+    let (mut a, mut b) = (
+        (best.0 / ratio).max(v_min_scan),
+        (best.0 * ratio).min(v_max),
+    );
     let g = 0.5 * (5f64.sqrt() - 1.0);
     for _ in 0..100 {
         let (x1, x2) = (b - g * (b - a), a + g * (b - a));
@@ -165,11 +171,11 @@ fn invert_monotone(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Result<f6
     }
     let (mut lo, mut hi) = (0.5 * (a + b), v_max);
     let smallest = f(lo);
-    if !(f(hi) >= target) {
+    let at_max = f(hi);
+    if at_max.is_nan() || at_max < target {
         return Err(Error::Unreachable {
             what: format!(
-                "radius {target} needs more than sv_maxvelocity = {v_max} ups (radius there {:.3})",
-                f(hi)
+                "radius {target} needs more than sv_maxvelocity = {v_max} ups (radius there {at_max:.3})"
             ),
         });
     }
