@@ -56,9 +56,18 @@ fn radius_relation_is_about_twice_the_measured_circle() {
 #[test]
 fn abh_article_table_and_crossing() {
     let a = abh::article_model(150.0, 0.51, 5249.34, 3500.0);
-    let speeds: Vec<String> = a.hops.iter().take(7).map(|h| format!("{:.0}", h.speed)).collect();
+    let speeds: Vec<String> = a
+        .hops
+        .iter()
+        .take(7)
+        .map(|h| format!("{:.0}", h.speed))
+        .collect();
     assert_eq!(speeds, ["225", "285", "405", "645", "1125", "2085", "3500"]);
-    let d: Vec<String> = a.hops.iter().map(|h| format!("{:.2}", h.distance)).collect();
+    let d: Vec<String> = a
+        .hops
+        .iter()
+        .map(|h| format!("{:.2}", h.distance))
+        .collect();
     assert_eq!(
         d,
         ["0.00", "114.75", "260.10", "466.65", "795.60", "1369.35", "2432.70", "4217.70"]

@@ -22,12 +22,7 @@ fn config() -> Config {
 
 /// Speeds from zero to 4000 ups, with the special values mixed in.
 fn speed() -> impl Strategy<Value = f64> {
-    prop_oneof![
-        Just(0.0),
-        Just(1e-9),
-        0.0..1.0f64,
-        0.0..4000.0f64,
-    ]
+    prop_oneof![Just(0.0), Just(1e-9), 0.0..1.0f64, 0.0..4000.0f64,]
 }
 
 /// Laws over realistic and extreme settings: L in the air (30) or on the ground (M), gamma1 for
@@ -37,8 +32,14 @@ fn law() -> impl Strategy<Value = AccelLaw> {
         (1.0..320.0f64, 0.0..400.0f64).prop_map(|(l, g)| AccelLaw { l, gamma1: g }),
         (0.0..30.0f64, 0.0..40.0f64).prop_map(|(l, g)| AccelLaw { l, gamma1: g }),
         (-50.0..50.0f64, -50.0..50.0f64).prop_map(|(l, g)| AccelLaw { l, gamma1: g }),
-        Just(AccelLaw { l: 30.0, gamma1: 0.0 }),
-        Just(AccelLaw { l: 30.0, gamma1: 30.0 }),
+        Just(AccelLaw {
+            l: 30.0,
+            gamma1: 0.0
+        }),
+        Just(AccelLaw {
+            l: 30.0,
+            gamma1: 30.0
+        }),
     ]
 }
 
@@ -149,18 +150,42 @@ proptest! {
 #[test]
 fn case_boundaries_are_continuous() {
     // |v| = L - gamma1 (cos zeta = 1), gamma1 = L (cases 1/2), cos zeta_bar = -1 (cases 4/5).
-    let law = AccelLaw { l: 30.0, gamma1: 3.2 };
+    let law = AccelLaw {
+        l: 30.0,
+        gamma1: 3.2,
+    };
     let at = max_accel(26.8, law);
     assert_eq!(at.case, MaxAccelCase::One);
     assert!((at.speed - 30.0).abs() < 1e-12);
-    let law = AccelLaw { l: 30.0, gamma1: 30.0 };
+    let law = AccelLaw {
+        l: 30.0,
+        gamma1: 30.0,
+    };
     let one = max_accel(500.0, law);
-    let two = max_accel(500.0, AccelLaw { l: 30.0, gamma1: 30.0 + 1e-12 });
+    let two = max_accel(
+        500.0,
+        AccelLaw {
+            l: 30.0,
+            gamma1: 30.0 + 1e-12,
+        },
+    );
     assert_eq!(one.case, MaxAccelCase::One);
     assert_eq!(two.case, MaxAccelCase::Two);
     assert!((one.speed - two.speed).abs() < 1e-9);
-    let four = max_accel(500.0, AccelLaw { l: -500.0, gamma1: -1.0 });
-    let five = max_accel(500.0, AccelLaw { l: -500.0 + 1e-9, gamma1: -1.0 });
+    let four = max_accel(
+        500.0,
+        AccelLaw {
+            l: -500.0,
+            gamma1: -1.0,
+        },
+    );
+    let five = max_accel(
+        500.0,
+        AccelLaw {
+            l: -500.0 + 1e-9,
+            gamma1: -1.0,
+        },
+    );
     assert_eq!(four.case, MaxAccelCase::Four);
     assert_eq!(five.case, MaxAccelCase::Five);
 }

@@ -163,7 +163,9 @@ fn frames_to_speed(engine: &EngineFlags, from: f64, to: f64, ground: bool) -> Re
         return Err(Error::invalid(
             "--to",
             to,
-            format!("at most sv_maxvelocity * sqrt 2 = {reachable:.4} ups (the per-component clamp)"),
+            format!(
+                "at most sv_maxvelocity * sqrt 2 = {reachable:.4} ups (the per-component clamp)"
+            ),
         ));
     }
     let closed = if ground {
@@ -191,7 +193,13 @@ fn frames_to_speed(engine: &EngineFlags, from: f64, to: f64, ground: bool) -> Re
     let (frames, method) = match closed {
         Some(n) if n > MAX_STEPPED_FRAMES => (n.ceil() as u64, "closed-form"),
         _ => (
-            frames_to_speed_by_stepping(&vars, from, to, ground, (MAX_STEPPED_FRAMES * 2.0) as u64)?,
+            frames_to_speed_by_stepping(
+                &vars,
+                from,
+                to,
+                ground,
+                (MAX_STEPPED_FRAMES * 2.0) as u64,
+            )?,
             "stepping",
         ),
     };
@@ -290,7 +298,8 @@ fn radius(engine: &EngineFlags, speed: f64) -> Result<Figures> {
 fn speed_for(engine: &EngineFlags, radius: f64) -> Result<Figures> {
     let vars = resolve_vars(engine, Preset::GoldSrc)?;
     require_positive("--radius", radius)?;
-    let measured = speed_for_radius(&vars, radius).map_err(|e| flag_unreachable("--radius", radius, e))?;
+    let measured =
+        speed_for_radius(&vars, radius).map_err(|e| flag_unreachable("--radius", radius, e))?;
     let source = speed_for_radius_source_text(&vars, radius).ok();
     Ok(Figures {
         json: json!({
@@ -349,7 +358,12 @@ fn bend(engine: &EngineFlags, width: f64) -> Result<Figures> {
     })
 }
 
-fn abh_table(engine: &EngineFlags, max_speed: f64, hop_time: f64, distance: f64) -> Result<Figures> {
+fn abh_table(
+    engine: &EngineFlags,
+    max_speed: f64,
+    hop_time: f64,
+    distance: f64,
+) -> Result<Figures> {
     let vars = resolve_vars(engine, Preset::SourceHl2)?;
     require_positive("--max-speed", max_speed)?;
     require_positive("--hop-time", hop_time)?;

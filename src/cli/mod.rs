@@ -22,7 +22,9 @@ pub const EXIT_NO_PATH: u8 = 3;
 /// The exit code for a library error.
 pub fn exit_code(e: &Error) -> u8 {
     match e {
-        Error::InvalidValue { .. } | Error::Scene { .. } | Error::Unreachable { .. } => EXIT_BAD_INPUT,
+        Error::InvalidValue { .. } | Error::Scene { .. } | Error::Unreachable { .. } => {
+            EXIT_BAD_INPUT
+        }
         Error::NoValidPath(_) => EXIT_NO_PATH,
         _ => EXIT_FAILURE,
     }
@@ -34,7 +36,12 @@ pub fn main_with_args(argv: impl IntoIterator<Item = std::ffi::OsString>) -> u8 
         Ok(cli) => cli,
         Err(e) => {
             use clap::error::ErrorKind;
-            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
                 let _ = e.print();
                 return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
                     EXIT_BAD_INPUT
@@ -59,7 +66,10 @@ pub fn main_with_args(argv: impl IntoIterator<Item = std::ffi::OsString>) -> u8 
     match run(&cli) {
         Ok(out) => {
             let mut stdout = std::io::stdout().lock();
-            match stdout.write_all(out.as_bytes()).and_then(|_| stdout.flush()) {
+            match stdout
+                .write_all(out.as_bytes())
+                .and_then(|_| stdout.flush())
+            {
                 Ok(()) => EXIT_OK,
                 // A closed pipe (`| head`) is not a failure.
                 Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => EXIT_OK,

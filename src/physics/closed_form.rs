@@ -114,7 +114,11 @@ pub fn max_groundstrafe_speed(vars: &MovementVars, edge_friction: bool) -> f64 {
     if gamma1 <= 0.0 {
         return 0.0;
     }
-    let b = if gamma1 > l { l * l } else { gamma1 * (2.0 * l - gamma1) };
+    let b = if gamma1 > l {
+        l * l
+    } else {
+        gamma1 * (2.0 * l - gamma1)
+    };
     let shrink = 1.0 - tau * k;
     let one_minus_a = 1.0 - shrink * shrink;
     if one_minus_a <= 0.0 {
@@ -210,10 +214,16 @@ mod tests {
 
     #[test]
     fn closed_form_speed_inverts_frames() {
-        let law = AccelLaw { l: 30.0, gamma1: 3.2 };
+        let law = AccelLaw {
+            l: 30.0,
+            gamma1: 3.2,
+        };
         for &(v0, v1) in &[(0.0, 100.0), (10.0, 27.0), (320.0, 1000.0)] {
             let n = airstrafe_frames_to_speed(v0, v1, law).unwrap_or(f64::NAN);
-            assert!((airstrafe_speed_after(v0, n, law) - v1).abs() < 1e-9, "{v0} {v1}");
+            assert!(
+                (airstrafe_speed_after(v0, n, law) - v1).abs() < 1e-9,
+                "{v0} {v1}"
+            );
         }
     }
 }

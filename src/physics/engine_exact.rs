@@ -155,7 +155,10 @@ mod tests {
             let q = quantise_yaw_rad(yaw);
             let back = f64::from(anglemod_deg(q.to_degrees() as f32));
             let want = q.to_degrees().rem_euclid(360.0);
-            assert!((back - want).abs() < 1e-3 * (360.0 / 65536.0), "{yaw}: {back} vs {want}");
+            assert!(
+                (back - want).abs() < 1e-3 * (360.0 / 65536.0),
+                "{yaw}: {back} vs {want}"
+            );
         }
     }
 }

@@ -144,7 +144,13 @@ impl Control {
     /// (positive turns left), holding the keys `forwardmove`, `sidemove`. The yaw is chosen so that
     /// `a_hat = R(theta) v_hat` (physics.md section 5): `yaw = angle(v) + theta + atan2(S, F)`. At zero
     /// velocity the direction is lost and `theta` is taken from `heading_rad` instead.
-    pub fn strafe(vel: Vec2, heading_rad: f64, theta_rad: f64, forwardmove: f64, sidemove: f64) -> Self {
+    pub fn strafe(
+        vel: Vec2,
+        heading_rad: f64,
+        theta_rad: f64,
+        forwardmove: f64,
+        sidemove: f64,
+    ) -> Self {
         let base = if vel.length_squared() > 0.0 {
             vel.angle()
         } else {
@@ -539,7 +545,8 @@ mod tests {
             for &theta in &[0.3, -1.2, 2.5] {
                 let c = Control::strafe(vel, 0.0, theta, f, s);
                 assert!((c.theta_rad(vel) - theta).abs() < 1e-12, "{f} {s} {theta}");
-                let st: Stepper<f64> = Stepper::new(&MovementVars::goldsrc(100.0), Effects::AIR_ONLY);
+                let st: Stepper<f64> =
+                    Stepper::new(&MovementVars::goldsrc(100.0), Effects::AIR_ONLY);
                 let (a_hat, _) = st.wish_direction(&c.wish(), false, false);
                 let expect = vel.normalized().unwrap().rotated(theta);
                 assert!((a_hat - expect).length() < 1e-12);
@@ -578,10 +585,7 @@ mod tests {
         };
         st.step(&mut s, &w);
         assert!(!s.on_ground);
-        let w = Wish {
-            jump: false,
-            ..w
-        };
+        let w = Wish { jump: false, ..w };
         let mut frames = 1;
         while !s.on_ground {
             st.step(&mut s, &w);
@@ -596,7 +600,9 @@ mod tests {
         assert!((t - 0.6633).abs() < 1e-4);
         let v0 = vars.jump_speed_ups();
         let z = |n: f64| 0.001 * (n * v0 - g * 0.001 * n * (n - 1.0) / 2.0);
-        let expected = (1..2000).find(|&n| z(n as f64) <= 2.0 && n > 10).unwrap_or(0);
+        let expected = (1..2000)
+            .find(|&n| z(n as f64) <= 2.0 && n > 10)
+            .unwrap_or(0);
         assert_eq!(frames, expected);
         assert_eq!(frames, 665);
     }
@@ -634,7 +640,12 @@ mod tests {
         // physics.md section 11: ducked, facing backwards, no keys: v -> 2|v| - 1.1 Mx.
         let mut vars = MovementVars::source_hl2(66.666_666_666_666_67);
         vars.maxspeed = 150.0;
-        let fx = Effects::from_list(&[Effect::Gravity, Effect::Jump, Effect::JumpBoost, Effect::Duck]);
+        let fx = Effects::from_list(&[
+            Effect::Gravity,
+            Effect::Jump,
+            Effect::JumpBoost,
+            Effect::Duck,
+        ]);
         let st: Stepper<f64> = Stepper::new(&vars, fx);
         let mut s = PlayerState::on_ground(Vec2::ZERO, Vec2::new(225.0, 0.0));
         s.ducked = true;
@@ -651,8 +662,7 @@ mod tests {
     #[test]
     fn max_velocity_clamps_each_component() {
         let vars = MovementVars::goldsrc(100.0);
-        let st: Stepper<f64> =
-            Stepper::new(&vars, Effects::AIR_ONLY.with(Effect::MaxVelocity));
+        let st: Stepper<f64> = Stepper::new(&vars, Effects::AIR_ONLY.with(Effect::MaxVelocity));
         let mut s = PlayerState::airborne(Vec2::ZERO, Vec2::new(2500.0, -2500.0));
         let w = Wish {
             forward: Vec2::new(1.0, 0.0),

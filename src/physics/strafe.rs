@@ -159,7 +159,7 @@ pub fn speed_preserving_cos_theta(speed_before: f64, lambda: f64, law: AccelLaw)
         return None;
     }
     let loss = speed_before * speed_before - lambda * lambda; // what friction took, in speed^2
-    // Piece boundaries: gamma2 = gamma1 at cos zeta, gamma2 = 0 at cos zeta_bar.
+                                                              // Piece boundaries: gamma2 = gamma1 at cos zeta, gamma2 = 0 at cos zeta_bar.
     let cos_zeta = (l - gamma1) / lambda;
     let cos_zeta_bar = l / lambda;
     let eps = 1e-12;
@@ -188,7 +188,9 @@ pub fn speed_preserving_cos_theta(speed_before: f64, lambda: f64, law: AccelLaw)
     solutions
         .into_iter()
         .filter(|c| c.is_finite() && (-1.0..=1.0).contains(c))
-        .fold(None, |best: Option<f64>, c| Some(best.map_or(c, |b| b.min(c))))
+        .fold(None, |best: Option<f64>, c| {
+            Some(best.map_or(c, |b| b.min(c)))
+        })
 }
 
 /// The sharpest turn of one frame (physics.md section 9): the `theta` in `[0, pi]` that turns the velocity
@@ -279,13 +281,7 @@ pub fn strafe_control(
     } else {
         heading_rad
     };
-    let mut c = Control::strafe(
-        probe.vel,
-        heading,
-        theta,
-        keys.forwardmove,
-        keys.sidemove,
-    );
+    let mut c = Control::strafe(probe.vel, heading, theta, keys.forwardmove, keys.sidemove);
     c.jump = keys.jump;
     c.duck = keys.duck;
     c
@@ -313,19 +309,22 @@ mod tests {
     #[test]
     fn case_formulas_match_the_scalar_fme_at_the_chosen_angle() {
         for &(lam, l, g) in &[
-            (500.0, 30.0, 3.2),   // case 1, cos zeta < 1
-            (10.0, 30.0, 3.2),    // case 1, cos = 1
-            (500.0, 30.0, 32.0),  // case 2
-            (500.0, -5.0, 3.0),   // case 3
+            (500.0, 30.0, 3.2),    // case 1, cos zeta < 1
+            (10.0, 30.0, 3.2),     // case 1, cos = 1
+            (500.0, 30.0, 32.0),   // case 2
+            (500.0, -5.0, 3.0),    // case 3
             (500.0, -600.0, -1.0), // case 4
-            (500.0, 30.0, -2.0),  // case 5
-            (0.0, 30.0, 3.2),     // zero speed
+            (500.0, 30.0, -2.0),   // case 5
+            (0.0, 30.0, 3.2),      // zero speed
             (0.0, 30.0, 32.0),
             (0.0, 0.0, 0.0),
         ] {
             let m = max_accel(lam, law(l, g));
             let direct = speed_after(lam, m.cos_theta, law(l, g));
-            assert!((m.speed - direct).abs() < 1e-9, "{lam} {l} {g}: {m:?} vs {direct}");
+            assert!(
+                (m.speed - direct).abs() < 1e-9,
+                "{lam} {l} {g}: {m:?} vs {direct}"
+            );
             assert!(m.speed.is_finite() && m.cos_theta.abs() <= 1.0);
         }
     }
