@@ -7,6 +7,7 @@
 pub mod cli;
 pub mod error;
 pub mod geometry;
+pub mod optimise;
 pub mod physics;
 pub mod scene;
 

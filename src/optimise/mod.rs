@@ -1,0 +1,3 @@
+//! Optimisation over control sequences: the lower bound on the time ([`bound`]).
+
+pub mod bound;
