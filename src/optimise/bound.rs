@@ -53,11 +53,11 @@ impl SpeedBound {
         let m = vars
             .maxspeed
             .min(vars.forward_key_speed.hypot(vars.side_key_speed));
-        let air = effects.has(Effect::AirAccel).then(|| AccelLaw {
+        let air = effects.has(Effect::AirAccel).then_some(AccelLaw {
             l: m.min(vars.air_speed_cap),
             gamma1: vars.entity_friction * tau * m * vars.airaccelerate,
         });
-        let ground = effects.has(Effect::GroundAccel).then(|| AccelLaw {
+        let ground = effects.has(Effect::GroundAccel).then_some(AccelLaw {
             l: m,
             gamma1: vars.entity_friction * tau * m * vars.accelerate,
         });
