@@ -49,6 +49,13 @@ pub fn boosted_speed(speed: f64, fm: f64, p: f64, mx: f64, facing_backwards: boo
 /// `Fm = Mx`) gives `1.5 Mx`; then each ducked backhop (`Fm = 0`, `p = 0.1`) doubles the excess over
 /// `1.1 Mx`, clamped to `max_velocity`; each hop lasts `hop_time_s` at constant speed. The table runs until
 /// the hop in which `distance_units` is crossed.
+///
+/// # Example
+/// The article's 100 m: the line is crossed 3.865 s after the first jump (section 12):
+/// ```
+/// let a = strafeopt::physics::abh::article_model(150.0, 0.51, 5249.34, 3500.0);
+/// assert_eq!(format!("{:.3}", a.crossing_time), "3.865");
+/// ```
 pub fn article_model(
     max_speed: f64,
     hop_time_s: f64,

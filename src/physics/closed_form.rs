@@ -41,6 +41,15 @@ fn linear_phase(v0: f64, n: f64, law: AccelLaw) -> (f64, f64) {
 /// Frames of maximum-acceleration airstrafing from `v0` to `v1` ups, by the closed form of physics.md
 /// section 6 (fractional: the frame in which `v1` is reached is its ceiling). `None` when the law cannot
 /// accelerate.
+///
+/// # Example
+/// 320 to 1000 ups at default Half-Life settings and 1000 fps takes about 4938 frames (section 12):
+/// ```
+/// use strafeopt::physics::{closed_form::airstrafe_frames_to_speed, curvature::air_law, MovementVars};
+/// let law = air_law(&MovementVars::goldsrc(1000.0));
+/// let n = airstrafe_frames_to_speed(320.0, 1000.0, law).unwrap();
+/// assert_eq!(n.round(), 4938.0);
+/// ```
 pub fn airstrafe_frames_to_speed(v0: f64, v1: f64, law: AccelLaw) -> Option<f64> {
     let AccelLaw { l, gamma1 } = law;
     if v1 <= v0 {
@@ -102,6 +111,14 @@ pub fn groundstrafe_frames_to_speed(
 /// sections 6 and 12): `M sqrt(k_e A (2 - tau k_e A) / (k (2 - tau k)))` in case 1 with geometric
 /// friction, `L / sqrt(1 - (1 - tau k)^2)` in case 2, and `(d^2 + b)/(2 d)` (`d = tau E k`) when the
 /// steady state lies in the arithmetic branch below `sv_stopspeed`. Infinite without friction.
+///
+/// # Example
+/// About 505.2 ups at 1000 fps and 498.2 ups at 100 fps with Half-Life defaults (section 12):
+/// ```
+/// use strafeopt::physics::{closed_form::max_groundstrafe_speed, MovementVars};
+/// let at = |fps| max_groundstrafe_speed(&MovementVars::goldsrc(fps), false);
+/// assert_eq!(format!("{:.1} {:.1}", at(1000.0), at(100.0)), "505.2 498.2");
+/// ```
 pub fn max_groundstrafe_speed(vars: &MovementVars, edge_friction: bool) -> f64 {
     let tau = vars.frame_time_s();
     let k = vars.friction_k(edge_friction);

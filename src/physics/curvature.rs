@@ -76,6 +76,14 @@ pub struct MaxAccelRadii {
 }
 
 /// The radii of maximum-acceleration airstrafing at `speed` (physics.md section 9).
+///
+/// # Example
+/// At 500 ups and 100 fps (theta = 90 degrees) the relation gives 167 units, the game draws 83.8:
+/// ```
+/// use strafeopt::physics::{curvature::max_accel_radii, MovementVars};
+/// let r = max_accel_radii(&MovementVars::goldsrc(100.0), 500.0);
+/// assert_eq!(format!("{:.0} {:.1}", r.source_text, r.measured), "167 83.8");
+/// ```
 pub fn max_accel_radii(vars: &MovementVars, speed: f64) -> MaxAccelRadii {
     let law = air_law(vars);
     let tau = vars.frame_time_s();

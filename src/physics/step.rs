@@ -34,7 +34,22 @@ pub struct PlayerState<R = f64> {
     pub unduck_elapsed_s: R,
 }
 
+/// Hull height standing, units (physics.md section 2).
+pub const HULL_HEIGHT_STANDING_UNITS: f64 = 72.0;
+/// Hull height ducked, units.
+pub const HULL_HEIGHT_DUCKED_UNITS: f64 = 36.0;
+
 impl<R: Real> PlayerState<R> {
+    /// The hull's height by duck state, units: 72 standing, 36 ducked (physics.md section 2).
+    #[inline]
+    pub fn hull_height_units(&self) -> f64 {
+        if self.ducked {
+            HULL_HEIGHT_DUCKED_UNITS
+        } else {
+            HULL_HEIGHT_STANDING_UNITS
+        }
+    }
+
     /// Horizontal speed `|v_xy|`, ups.
     #[inline]
     pub fn speed(&self) -> R {
