@@ -183,7 +183,8 @@ fn scalar_fme_agrees_with_the_step_for_random_angles() {
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
         let speed = (seed >> 11) as f64 / (1u64 << 53) as f64 * 3000.0;
-        let theta = ((seed >> 7) % 10_000) as f64 / 10_000.0 * 6.283 - 3.1415;
+        let theta =
+            ((seed >> 7) % 10_000) as f64 / 10_000.0 * std::f64::consts::TAU - std::f64::consts::PI;
         let vel = Vec2::new(speed, 0.0);
         let c = Control::strafe(vel, 0.0, theta, 0.0, 400.0);
         let mut s = PlayerState::airborne(Vec2::ZERO, vel);
