@@ -1,7 +1,8 @@
 //! strafeopt: minimal-time strafing paths for Half-Life (GoldSrc) and Half-Life 2 (Source) movement.
 //!
-//! Data flows one way: [`scene`] -> [`sim`] -> [`optimise`] -> [`report`]. [`physics`] is the algebra
-//! layer under all of them; [`geometry`] holds the corridor and the swept player hull.
+//! Data flows one way: [`scene`] -> simulation -> [`optimise`] -> reports. [`physics`] is the algebra
+//! layer under all of them; [`geometry`] holds the corridor and the swept player hull, and the scene's
+//! walls and finish line are geometry's types, so scene validation and simulation agree on contact.
 #![warn(missing_docs)]
 
 pub mod cli;

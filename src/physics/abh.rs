@@ -96,29 +96,3 @@ pub fn article_model(
         landing_past_line: f64::NAN,
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn reproduces_the_article_table() {
-        let a = article_model(150.0, 0.51, 5249.34, 3500.0);
-        let speeds: Vec<f64> = a.hops.iter().map(|h| h.speed).collect();
-        assert_eq!(
-            speeds,
-            vec![225.0, 285.0, 405.0, 645.0, 1125.0, 2085.0, 3500.0, 3500.0]
-        );
-        let d: Vec<String> = a
-            .hops
-            .iter()
-            .map(|h| format!("{:.2}", h.distance))
-            .collect();
-        assert_eq!(
-            d,
-            ["0.00", "114.75", "260.10", "466.65", "795.60", "1369.35", "2432.70", "4217.70"]
-        );
-        assert_eq!(format!("{:.3}", a.crossing_time), "3.865");
-        assert_eq!(format!("{:.2}", a.landing_past_line), "753.36");
-    }
-}

@@ -1,1 +1,0 @@
-//! (geometry: being written)

@@ -1,0 +1,294 @@
+//! From a parsed [`SceneFile`] to a validated [`Scene`], with every error located at its key's line.
+
+use super::file::{Point, SceneFile};
+use super::locate::KeyIndex;
+use super::shorthand::{BadParam, Expanded};
+use super::{Scene, DEFAULT_MAX_TIME_S};
+use crate::error::{Error, Result};
+use crate::geometry::{
+    BoundaryKind, Corridor, FinishLine, Wall, CONTACT_TOL_UNITS, MIN_SEGMENT_LENGTH_UNITS,
+};
+use crate::physics::{Effect, Effects, MovementVars, PlayerState, Vec2};
+use serde::Deserialize;
+use std::path::Path;
+use toml::de::DeTable;
+
+/// Parses, then validates.
+pub(crate) fn scene_from_str(text: &str, origin: &str) -> Result<Scene> {
+    let doc = DeTable::parse(text).map_err(|e| KeyIndex::empty(origin, text).toml_error(&e))?;
+    let index = KeyIndex::new(origin, text, &doc);
+    let file = SceneFile::deserialize(toml::de::Deserializer::from(doc))
+        .map_err(|e| index.toml_error(&e))?;
+    build(file, &index, origin)
+}
+
+/// A shorthand shape that was given: its table name and expansion.
+struct Shape {
+    name: &'static str,
+    expanded: Expanded,
+}
+
+fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
+    let shape = shorthand(&file, ix)?;
+
+    // Engine: preset + overrides, then effects (physics.md sections 2, 3).
+    let engine = &file.engine;
+    let fps = engine.overrides.fps.ok_or_else(|| {
+        ix.error(
+            "engine.fps",
+            "missing; give the frame rate, a finite number above 0 (tau = 1/fps s)",
+        )
+    })?;
+    let vars = engine
+        .overrides
+        .apply(MovementVars::preset(engine.preset, fps))
+        .map_err(|e| engine_error(ix, e))?;
+    let effects = Effects::from_list(&engine.effects);
+    if let Some((effect, needs)) = effects.missing_requirement() {
+        return Err(ix.error(
+            "engine.effects",
+            format!("effect \"{effect}\" needs \"{needs}\"; add \"{needs}\" to the list"),
+        ));
+    }
+    let max_frames = match file.max_frames {
+        Some(0) => return Err(ix.error("max-frames", "got 0; must be at least 1")),
+        Some(n) => n,
+        // Finite and positive: vars.validate() checked the frame time.
+        None => (DEFAULT_MAX_TIME_S / vars.frame_time_s()).ceil() as u64,
+    };
+
+    // Walls: the shape's, then the file's; `wall_keys` names each in messages.
+    let mut walls = Vec::new();
+    let mut wall_keys = Vec::new();
+    if let Some(s) = &shape {
+        for w in &s.expanded.walls {
+            walls.push(w.clone());
+            wall_keys.push(s.name.to_string());
+        }
+    }
+    for (i, wf) in file.walls.iter().enumerate() {
+        walls.push(Wall {
+            points: wf.points.iter().map(|p| p.0).collect(),
+            closed: wf.closed,
+            kind: wf.kind,
+        });
+        wall_keys.push(format!("walls[{i}]"));
+    }
+    for (wall, key) in walls.iter().zip(&wall_keys) {
+        if let Some(defect) = wall.defect() {
+            let points_key = if key.starts_with("walls[") {
+                format!("{key}.points")
+            } else {
+                key.clone()
+            };
+            let locate_at = match defect.point() {
+                Some(p) if key.starts_with("walls[") => format!("{points_key}[{p}]"),
+                _ => points_key.clone(),
+            };
+            return Err(ix.error_at(&points_key, &locate_at, defect.to_string()));
+        }
+        if wall.kind == BoundaryKind::Solid && !effects.has(Effect::Walls) {
+            return Err(ix.error(
+                &format!("{key}.kind"),
+                "solid walls need the \"walls\" effect; add \"walls\" to engine.effects, or use \
+                 kind = \"rule\"",
+            ));
+        }
+    }
+
+    let start = start_state(&file, shape.as_ref(), &vars, effects, ix)?;
+    let (finish, finish_key) = finish_line(&file, shape.as_ref(), ix)?;
+
+    // Geometry: the start hull must be clear of every wall, and the finish reachable from it.
+    let corridor = Corridor::new(&walls)?;
+    let start_key = if file.start.as_ref().and_then(|s| s.position).is_some() {
+        "start.position"
+    } else {
+        shape.as_ref().map_or("start.position", |s| s.name)
+    };
+    if let Some(n) = corridor.nearest(start.pos, None) {
+        if n.clearance_units < -CONTACT_TOL_UNITS {
+            return Err(ix.error_at(
+                "start.position",
+                start_key,
+                format!(
+                    "the hull at ({}, {}) overlaps {} (segment {}) by {} units; the 32 x 32 hull may touch a \
+                     wall but not overlap it",
+                    start.pos.x,
+                    start.pos.y,
+                    wall_keys[n.wall],
+                    n.segment,
+                    -n.clearance_units
+                ),
+            ));
+        }
+    }
+    if corridor
+        .shortest_path(start.pos, (finish.a, finish.b))
+        .is_none()
+    {
+        return Err(ix.error(
+            &finish_key,
+            format!(
+                "no path for the hull from the start ({}, {}) to the finish line ({}, {})-({}, {}); the walls \
+                 must leave the 32 x 32 hull a way through",
+                start.pos.x, start.pos.y, finish.a.x, finish.a.y, finish.b.x, finish.b.y
+            ),
+        ));
+    }
+
+    let name = file.name.clone().unwrap_or_else(|| {
+        Path::new(origin)
+            .file_stem()
+            .map_or_else(|| origin.to_string(), |s| s.to_string_lossy().into_owned())
+    });
+    Ok(Scene {
+        name,
+        description: file.description.clone().unwrap_or_default(),
+        origin: origin.to_string(),
+        preset: engine.preset,
+        vars,
+        effects,
+        start,
+        finish,
+        walls,
+        max_frames,
+    })
+}
+
+/// The one shorthand shape given, expanded; an error when more than one is given or a parameter is out
+/// of range.
+fn shorthand(file: &SceneFile, ix: &KeyIndex<'_>) -> Result<Option<Shape>> {
+    let mut given: Vec<(&'static str, std::result::Result<Expanded, BadParam>)> = [
+        file.bend90.map(|s| ("bend90", s.expand())),
+        file.hairpin.map(|s| ("hairpin", s.expand())),
+        file.lane.map(|s| ("lane", s.expand())),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if given.len() > 1 {
+        // Blame the one written later.
+        given.sort_by_key(|(name, _)| ix.line_of(name));
+        return Err(ix.error(
+            given[1].0,
+            format!(
+                "a scene takes at most one shorthand shape ([bend90], [hairpin] or [lane]); [{}] is given \
+                 already",
+                given[0].0
+            ),
+        ));
+    }
+    match given.into_iter().next() {
+        None => Ok(None),
+        Some((name, Ok(expanded))) => Ok(Some(Shape { name, expanded })),
+        Some((name, Err(bad))) => Err(ix.error(&format!("{name}.{}", bad.key), bad.message)),
+    }
+}
+
+/// An error from validating the movement variables, at its `[engine]` key.
+fn engine_error(ix: &KeyIndex<'_>, e: Error) -> Error {
+    match e {
+        Error::InvalidValue {
+            name,
+            value,
+            allowed,
+        } => ix.error(
+            &format!("engine.{name}"),
+            format!("got {value}; must be {allowed}"),
+        ),
+        other => ix.error("engine", other.to_string()),
+    }
+}
+
+fn finite_point(ix: &KeyIndex<'_>, key: &str, p: Point) -> Result<Vec2> {
+    if p.0.is_finite() {
+        Ok(p.0)
+    } else {
+        Err(ix.error(key, "must be two finite numbers"))
+    }
+}
+
+/// The player at frame 0: the file's `[start]`, defaults from the shape.
+fn start_state(
+    file: &SceneFile,
+    shape: Option<&Shape>,
+    vars: &MovementVars,
+    effects: Effects,
+    ix: &KeyIndex<'_>,
+) -> Result<PlayerState> {
+    let sf = file.start.clone().unwrap_or_default();
+    let pos = match (sf.position, shape) {
+        (Some(p), _) => finite_point(ix, "start.position", p)?,
+        (None, Some(s)) => s.expanded.start_position,
+        (None, None) => {
+            return Err(ix.error(
+                "start.position",
+                "missing; give the hull centre [x, y] in units (only a shorthand shape supplies a default)",
+            ))
+        }
+    };
+    let vel = match (sf.velocity, shape) {
+        (Some(v), _) => finite_point(ix, "start.velocity", v)?,
+        (None, Some(s)) => s.expanded.start_direction * vars.maxspeed,
+        (None, None) => Vec2::ZERO,
+    };
+    let ducked = sf.ducked.unwrap_or(false);
+    if ducked && !effects.has(Effect::Duck) {
+        return Err(ix.error(
+            "start.ducked",
+            "a ducked start needs the \"duck\" effect; add \"duck\" to engine.effects",
+        ));
+    }
+    let on_ground = sf.on_ground.unwrap_or(false);
+    Ok(PlayerState {
+        ducked,
+        ..if on_ground {
+            PlayerState::on_ground(pos, vel)
+        } else {
+            PlayerState::airborne(pos, vel)
+        }
+    })
+}
+
+/// The finish line (the file's `[finish]`, else the shape's) and the key to blame for it.
+fn finish_line(
+    file: &SceneFile,
+    shape: Option<&Shape>,
+    ix: &KeyIndex<'_>,
+) -> Result<(FinishLine, String)> {
+    let ff = file.finish.clone().unwrap_or_default();
+    let ((a, b), key) = match (ff.a, ff.b, shape) {
+        (Some(a), Some(b), _) => (
+            (
+                finite_point(ix, "finish.a", a)?,
+                finite_point(ix, "finish.b", b)?,
+            ),
+            "finish".to_string(),
+        ),
+        (None, None, Some(s)) => (s.expanded.finish, s.name.to_string()),
+        (Some(_), None, _) => return Err(ix.error("finish.b", "missing; give both ends, a and b")),
+        (None, Some(_), _) => return Err(ix.error("finish.a", "missing; give both ends, a and b")),
+        (None, None, None) => {
+            return Err(ix.error(
+                "finish",
+                "missing; give [finish] with ends a and b, or a shorthand shape ([bend90], [hairpin], [lane])",
+            ))
+        }
+    };
+    let finish = FinishLine {
+        a,
+        b,
+        point: ff.point.unwrap_or_default(),
+    };
+    if finish.length_units() <= MIN_SEGMENT_LENGTH_UNITS {
+        return Err(ix.error(
+            &key,
+            format!(
+                "the finish line has zero length; a and b must be more than {MIN_SEGMENT_LENGTH_UNITS:e} units \
+                 apart"
+            ),
+        ));
+    }
+    Ok((finish, key))
+}
