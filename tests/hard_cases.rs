@@ -5,7 +5,7 @@ use strafeopt::physics::strafe::{
     max_accel, max_accel_control, speed_after, strafe_keys, MaxAccelCase,
 };
 use strafeopt::physics::{
-    AccelLaw, Control, Effect, Effects, MovementVars, PlayerState, Side, Stepper, Vec2, Wish,
+    AccelLaw, Control, Effect, Effects, MovementVars, PlayerState, Side, Stepper, Vec2,
 };
 
 /// The FME in vector form, written independently of the library: v' = v + mu a_hat.
@@ -195,5 +195,4 @@ fn scalar_fme_agrees_with_the_step_for_random_angles() {
             "{speed} {theta}"
         );
     }
-    let _ = Wish::<f64>::default();
 }

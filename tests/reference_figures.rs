@@ -6,7 +6,7 @@ use strafeopt::physics::closed_form::{
     max_groundstrafe_speed_by_stepping,
 };
 use strafeopt::physics::curvature::{air_law, max_accel_radii, speed_for_radius};
-use strafeopt::physics::{abh, MovementVars};
+use strafeopt::physics::{abh, Effect, Effects, MovementVars, PlayerState, Stepper, Vec2, Wish};
 
 #[test]
 fn airstrafe_320_to_1000_at_1000_fps_takes_about_4938_frames() {
@@ -78,7 +78,20 @@ fn abh_article_table_and_crossing() {
 
 #[test]
 fn bunnyhop_cap_drops_544_plus_to_353_6() {
-    let m = 320.0;
-    assert_eq!(format!("{:.1}", 1.105 * m), "353.6");
-    assert_eq!(format!("{:.0}", 1.7 * m), "544");
+    // Jumping above 1.7 x 320 = 544 ups drops the speed to 1.105 x 320 = 353.6 (section 10), through the
+    // library's own frame.
+    let vars = MovementVars::goldsrc(100.0);
+    let fx = Effects::from_list(&[Effect::Gravity, Effect::Jump, Effect::BhopCap]);
+    let st: Stepper<f64> = Stepper::new(&vars, fx);
+    let jump = Wish {
+        forward: Vec2::new(1.0, 0.0),
+        jump: true,
+        ..Wish::default()
+    };
+    for (speed, expect) in [(600.0, "353.6"), (1500.0, "353.6"), (500.0, "500.0")] {
+        let mut s = PlayerState::on_ground(Vec2::ZERO, Vec2::new(speed, 0.0));
+        st.pre_move(&mut s, &jump);
+        assert_eq!(format!("{:.1}", s.speed()), expect, "from {speed}");
+        assert!(!s.on_ground);
+    }
 }

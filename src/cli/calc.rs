@@ -8,10 +8,10 @@ use crate::physics::closed_form::{
     max_groundstrafe_speed, max_groundstrafe_speed_by_stepping,
 };
 use crate::physics::curvature::{
-    air_law, bend_arc_radius, max_accel_radii, speed_for_radius, speed_for_radius_source_text,
-    HULL_WIDTH_UNITS,
+    air_law, bend_arc_radius, ground_law, max_accel_radii, speed_for_radius,
+    speed_for_radius_source_text, HULL_WIDTH_UNITS,
 };
-use crate::physics::{abh, AccelLaw, MovementVars, Preset, VarOverrides};
+use crate::physics::{abh, MovementVars, Preset, VarOverrides};
 use serde_json::{json, Value};
 
 /// Most frames `frames-to-speed` steps before it trusts the closed form alone.
@@ -143,14 +143,6 @@ pub fn wants_json(form: &CalcForm) -> bool {
         | CalcForm::SpeedForRadius { output, .. }
         | CalcForm::Bend { output, .. }
         | CalcForm::Abh { output, .. } => output.json,
-    }
-}
-
-fn ground_law(vars: &MovementVars) -> AccelLaw {
-    let m = vars.maxspeed.min(vars.side_key_speed);
-    AccelLaw {
-        l: m,
-        gamma1: vars.entity_friction * vars.frame_time_s() * m * vars.accelerate,
     }
 }
 

@@ -50,17 +50,16 @@ impl SpeedBound {
     /// The bound for `vars` and `effects` with full keys.
     pub fn new(vars: &MovementVars, effects: Effects) -> Self {
         let tau = vars.frame_time_s();
+        // The largest wish speed any keys give: both keys held.
         let m = vars
             .maxspeed
             .min(vars.forward_key_speed.hypot(vars.side_key_speed));
-        let air = effects.has(Effect::AirAccel).then_some(AccelLaw {
-            l: m.min(vars.air_speed_cap),
-            gamma1: vars.entity_friction * tau * m * vars.airaccelerate,
-        });
-        let ground = effects.has(Effect::GroundAccel).then_some(AccelLaw {
-            l: m,
-            gamma1: vars.entity_friction * tau * m * vars.accelerate,
-        });
+        let air = effects
+            .has(Effect::AirAccel)
+            .then(|| AccelLaw::air(vars, m));
+        let ground = effects
+            .has(Effect::GroundAccel)
+            .then(|| AccelLaw::ground(vars, m));
         let friction = effects.has(Effect::Friction).then(|| {
             (
                 tau * vars.friction_k(effects.has(Effect::EdgeFriction)),

@@ -122,12 +122,7 @@ pub fn groundstrafe_frames_to_speed(
 pub fn max_groundstrafe_speed(vars: &MovementVars, edge_friction: bool) -> f64 {
     let tau = vars.frame_time_s();
     let k = vars.friction_k(edge_friction);
-    let m = vars.maxspeed.min(vars.side_key_speed.hypot(0.0));
-    let law = AccelLaw {
-        l: m,
-        gamma1: vars.entity_friction * tau * m * vars.accelerate,
-    };
-    let AccelLaw { l, gamma1 } = law;
+    let AccelLaw { l, gamma1 } = AccelLaw::ground(vars, vars.maxspeed.min(vars.side_key_speed));
     if gamma1 <= 0.0 {
         return 0.0;
     }

@@ -53,11 +53,12 @@ pub fn circumradius(a: Vec2, b: Vec2, c: Vec2) -> f64 {
 
 /// The airstrafing law of `vars` (full strafe key, airborne): `L = min(30, M)`, `gamma1 = k_e tau M A`.
 pub fn air_law(vars: &MovementVars) -> AccelLaw {
-    let m = vars.maxspeed.min(vars.side_key_speed);
-    AccelLaw {
-        l: m.min(vars.air_speed_cap),
-        gamma1: vars.entity_friction * vars.frame_time_s() * m * vars.airaccelerate,
-    }
+    AccelLaw::air(vars, vars.maxspeed.min(vars.side_key_speed))
+}
+
+/// The groundstrafing law of `vars` (full strafe key, on the ground): `L = M`, `gamma1 = k_e tau M A`.
+pub fn ground_law(vars: &MovementVars) -> AccelLaw {
+    AccelLaw::ground(vars, vars.maxspeed.min(vars.side_key_speed))
 }
 
 /// All the radii of maximum-acceleration airstrafing at `speed` ups.
@@ -117,7 +118,7 @@ pub fn measured_radius(vars: &MovementVars, speed: f64) -> f64 {
 /// The speed whose measured maximum-acceleration radius is `radius` units, by bisection (the radius grows
 /// monotonically with speed). Errors when `radius` is beyond what speeds up to `sv_maxvelocity` draw.
 pub fn speed_for_radius(vars: &MovementVars, radius: f64) -> Result<f64> {
-    invert_monotone(|v| measured_radius(vars, v), radius, vars.maxvelocity)
+    invert_rising_branch(|v| measured_radius(vars, v), radius, vars.maxvelocity)
 }
 
 /// The speed whose radius by the source text's relation is `radius` (type 2 in closed form
@@ -137,7 +138,7 @@ pub fn speed_for_radius_source_text(vars: &MovementVars, radius: f64) -> Result<
         }
         return Ok(v2.sqrt());
     }
-    invert_monotone(
+    invert_rising_branch(
         |v| {
             let m = max_accel(v, law);
             radius_source_text(v, m.cos_theta, mu_at(v, m.cos_theta, law), tau)
@@ -151,7 +152,7 @@ pub fn speed_for_radius_source_text(vars: &MovementVars, radius: f64) -> Result<
 /// maximum acceleration goes straight ahead (infinite radius), so the radius first falls with speed and then
 /// rises: the smallest radius is located by a log-spaced scan refined by golden section, and the target is
 /// bracketed above it.
-fn invert_monotone(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Result<f64> {
+fn invert_rising_branch(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Result<f64> {
     const SCAN: usize = 400;
     let v_min_scan = 1e-3_f64;
     let ratio = (v_max / v_min_scan).powf(1.0 / SCAN as f64);

@@ -201,6 +201,25 @@ pub struct AccelLaw<R = f64> {
     pub gamma1: R,
 }
 
+impl AccelLaw<f64> {
+    /// The air law for wish speed `m` ups (physics.md section 5): `L = min(30, M)`,
+    /// `gamma1 = k_e tau M A_air`.
+    pub fn air(vars: &MovementVars, m: f64) -> Self {
+        AccelLaw {
+            l: m.min(vars.air_speed_cap),
+            gamma1: vars.entity_friction * vars.frame_time_s() * m * vars.airaccelerate,
+        }
+    }
+
+    /// The ground law for wish speed `m` ups: `L = M`, `gamma1 = k_e tau M A`.
+    pub fn ground(vars: &MovementVars, m: f64) -> Self {
+        AccelLaw {
+            l: m,
+            gamma1: vars.entity_friction * vars.frame_time_s() * m * vars.accelerate,
+        }
+    }
+}
+
 impl<R: Real> AccelLaw<R> {
     /// `mu = min(gamma1, gamma2)` if `gamma2 = L - lambda(v).a_hat > 0`, else 0 (physics.md section 5), given
     /// `c = lambda(v).a_hat`.
