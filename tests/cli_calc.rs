@@ -3,12 +3,23 @@
 
 use assert_cmd::Command;
 use serde_json::Value;
+use std::process::Output;
+
+/// Runs the real binary with `args`.
+fn strafeopt(args: &[&str]) -> Output {
+    Command::cargo_bin("strafeopt")
+        .map(|mut c| c.args(args).output())
+        .unwrap_or_else(|e| panic!("binary: {e}"))
+        .unwrap_or_else(|e| panic!("run {args:?}: {e}"))
+}
 
 fn calc(args: &[&str]) -> Value {
-    let out = Command::cargo_bin("strafeopt")
-        .map(|mut c| c.arg("calc").args(args).arg("--json").output())
-        .unwrap_or_else(|e| panic!("binary: {e}"))
-        .unwrap_or_else(|e| panic!("run: {e}"));
+    let full: Vec<&str> = ["calc"]
+        .into_iter()
+        .chain(args.iter().copied())
+        .chain(["--json"])
+        .collect();
+    let out = strafeopt(&full);
     assert!(
         out.status.success(),
         "{args:?}: {}",
@@ -139,13 +150,7 @@ fn abh_json() {
 
 #[test]
 fn text_output_shows_both_methods() {
-    let out = Command::cargo_bin("strafeopt")
-        .map(|mut c| {
-            c.args(["calc", "radius", "--speed", "500", "--fps", "100"])
-                .output()
-        })
-        .unwrap_or_else(|e| panic!("{e}"))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let out = strafeopt(&["calc", "radius", "--speed", "500", "--fps", "100"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("166.9667") && text.contains("83.8208"),
@@ -154,10 +159,7 @@ fn text_output_shows_both_methods() {
 }
 
 fn bad(args: &[&str], flag: &str) {
-    let out = Command::cargo_bin("strafeopt")
-        .map(|mut c| c.args(args).output())
-        .unwrap_or_else(|e| panic!("{e}"))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let out = strafeopt(args);
     assert_eq!(out.status.code(), Some(2), "{args:?}");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
