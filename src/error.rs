@@ -38,6 +38,9 @@ pub enum Error {
     /// No control sequence can reach the finish without breaking a rule.
     #[error("no valid path: {0}")]
     NoValidPath(String),
+    /// A file could not be written (the path and the system's reason).
+    #[error("{0}")]
+    Io(String),
     /// A numerical failure the library could not recover from (a NaN at a stage boundary).
     #[error("numerical error: {0}")]
     Numerical(String),

@@ -10,6 +10,8 @@ pub mod error;
 pub mod geometry;
 pub mod optimise;
 pub mod physics;
+pub mod report;
 pub mod scene;
+pub mod sim;
 
 pub use error::{Error, Result};

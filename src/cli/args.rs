@@ -2,6 +2,7 @@
 //! only what was typed. [`super::calc`] resolves them into library values; the library never sees clap.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
 
 /// strafeopt: minimal-time strafing paths for Half-Life and Half-Life 2 movement.
 #[derive(Debug, Parser)]
@@ -17,6 +18,38 @@ pub struct Cli {
 pub enum Command {
     /// Figures from the physics reference: closed forms beside frame-by-frame simulation.
     Calc(CalcArgs),
+    /// Simulate a scene with a controller; print its time beside the lower bound.
+    Simulate(SimulateArgs),
+}
+
+/// Controllers `simulate` can run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ControllerArg {
+    /// Maximum acceleration, steering left or right towards a look-ahead point on the shortest path.
+    Greedy,
+    /// Maximum acceleration turning left every frame.
+    MaxAccelLeft,
+    /// Maximum acceleration turning right every frame.
+    MaxAccelRight,
+}
+
+/// `strafeopt simulate SCENE ...`
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// The scene file (TOML).
+    pub scene: PathBuf,
+    /// Who steers.
+    #[arg(long, value_enum, default_value_t = ControllerArg::Greedy)]
+    pub controller: ControllerArg,
+    /// Greedy look-ahead distance, units (default: the best of a sweep from 25 to 1200).
+    #[arg(long, allow_negative_numbers = true)]
+    pub lookahead: Option<f64>,
+    /// Write the trajectory, one row per frame (`.csv`, or `.json` for JSON).
+    #[arg(long)]
+    pub trajectory: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub output: OutputFlags,
 }
 
 /// `strafeopt calc FORM ...`

@@ -4,6 +4,7 @@
 
 pub mod args;
 pub mod calc;
+pub mod simulate;
 
 use crate::error::Error;
 use args::{Cli, Command};
@@ -89,6 +90,7 @@ pub fn main_with_args(argv: impl IntoIterator<Item = std::ffi::OsString>) -> u8 
 /// Runs a parsed command and returns what to print.
 pub fn run(cli: &Cli) -> Result<String, Error> {
     match &cli.command {
+        Command::Simulate(a) => simulate::run(a),
         Command::Calc(c) => {
             let figures = calc::run(&c.form)?;
             if calc::wants_json(&c.form) {
@@ -98,4 +100,30 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
             }
         }
     }
+}
+
+/// Writes a file through a temporary name in the same directory and renames it into place, so an
+/// interrupted run never leaves a half-written file.
+pub fn write_atomically(
+    path: &std::path::Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> Result<(), Error> {
+    let io_err = |e: std::io::Error| Error::Io(format!("{}: {e}", path.display()));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "output".to_string());
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let file = std::fs::File::create(&tmp)?;
+        let mut w = std::io::BufWriter::new(file);
+        write(&mut w)?;
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(io_err)
 }

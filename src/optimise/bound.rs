@@ -8,32 +8,13 @@
 //! caps it at `V_max sqrt 2`), that friction never raises it, and that the new speed of maximum acceleration
 //! grows with the old one.
 
+use crate::error::{Error, Result};
+use crate::geometry::{Corridor, FinishPoint, HULL_HALF_WIDTH_UNITS};
 use crate::physics::strafe::max_accel;
-use crate::physics::{AccelLaw, Effect, Effects, MovementVars, PlayerState};
+use crate::physics::{AccelLaw, Effect, Effects, MovementVars, PlayerState, Vec2};
+use crate::scene::Scene;
+pub use crate::sim::Crossing;
 use serde::Serialize;
-
-/// When a bound (or a run) crosses the line: in frame `frames` (1-based), `fraction` of the way through
-/// it, at `time = (frames - 1 + fraction) tau` seconds.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Crossing {
-    /// The frame in which the line is crossed (1-based).
-    pub frames: u64,
-    /// How far through that frame, in `[0, 1]`.
-    pub fraction: f64,
-    /// Fractional crossing time, seconds.
-    pub time: f64,
-}
-
-impl Crossing {
-    /// The crossing in frame `frames` at `fraction` for frame time `tau_s`.
-    pub fn new(frames: u64, fraction: f64, tau_s: f64) -> Self {
-        Crossing {
-            frames,
-            fraction,
-            time: ((frames as f64) - 1.0 + fraction) * tau_s,
-        }
-    }
-}
 
 /// The greedy speed profile's upper bound on the speed after one more frame, ups, for the effects a scene
 /// runs. Handles airborne and ground strafing (friction); a scene that can be on the ground uses the larger
@@ -44,6 +25,8 @@ pub struct SpeedBound {
     ground: Option<AccelLaw>,
     friction: Option<(f64, f64)>,
     clamp_speed: Option<f64>,
+    /// `Mx` when the Source jump boost can fire (physics.md section 11).
+    jump_boost_maxspeed: Option<f64>,
 }
 
 impl SpeedBound {
@@ -69,16 +52,27 @@ impl SpeedBound {
         let clamp_speed = effects
             .has(Effect::MaxVelocity)
             .then_some(vars.maxvelocity * std::f64::consts::SQRT_2);
+        let jump_boost_maxspeed = effects.has(Effect::JumpBoost).then_some(vars.maxspeed);
         SpeedBound {
             air,
             ground,
             friction,
             clamp_speed,
+            jump_boost_maxspeed,
         }
     }
 
     /// The largest speed after one frame from any velocity of speed at most `speed`.
+    ///
+    /// With the Source jump boost a jump may come first: it adds `add` along the view with
+    /// `add + |v| <= (1 + p) Mx` when positive, and `|v| - (1 + p) Mx` when the speed is above the cap
+    /// (section 11), so the speed after it is at most `max(|v|, 1.5 Mx, 2|v| - 1.1 Mx)`. The bound lets a
+    /// jump happen on every frame, which is generous but never wrong.
     pub fn next(&self, speed: f64) -> f64 {
+        let speed = match self.jump_boost_maxspeed {
+            Some(mx) => speed.max(1.5 * mx).max(2.0 * speed - 1.1 * mx),
+            None => speed,
+        };
         let s = self.clamp_speed.map_or(speed, |c| speed.min(c));
         let mut best = s; // no acceleration at all keeps at most the speed
         if let Some(law) = self.air {
@@ -130,6 +124,54 @@ pub fn time_to_cover(
         covered += step;
     }
     None
+}
+
+/// The lower bound of a scene: the shortest path of the hull centre through the corridor (walls grown by
+/// the hull) and the time the greedy speed profile needs to cover it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LowerBound {
+    /// Length of the path the bound covers, units.
+    pub path_length: f64,
+    /// The shortest path's corners, from the start to the finish line.
+    pub path: Vec<Vec2>,
+    /// When the greedy speed profile covers it.
+    pub crossing: Crossing,
+}
+
+/// The lower bound of `scene` through `corridor` (physics.md section 6). For a `hull` finish the centre
+/// need only come within the box of the line, at most `16 sqrt 2` units short of it, so that much is
+/// taken off the path. Errors with [`Error::NoValidPath`] when no path reaches the finish.
+pub fn lower_bound(scene: &Scene, corridor: &Corridor) -> Result<LowerBound> {
+    let (length, path) = corridor
+        .shortest_path(scene.start.pos, (scene.finish.a, scene.finish.b))
+        .ok_or_else(|| {
+            Error::NoValidPath(format!(
+                "{}: no path for the 32-unit hull from the start to the finish line",
+                scene.origin
+            ))
+        })?;
+    let path_length = match scene.finish.point {
+        FinishPoint::Centre => length,
+        FinishPoint::Hull => (length - HULL_HALF_WIDTH_UNITS * std::f64::consts::SQRT_2).max(0.0),
+    };
+    let crossing = time_to_cover(
+        &scene.vars,
+        scene.effects,
+        &scene.start,
+        path_length,
+        scene.max_frames,
+    )
+    .ok_or_else(|| {
+        Error::NoValidPath(format!(
+            "{}: even the greedy speed profile cannot cover {path_length:.3} units in {} frames",
+            scene.origin, scene.max_frames
+        ))
+    })?;
+    Ok(LowerBound {
+        path_length,
+        path,
+        crossing,
+    })
 }
 
 #[cfg(test)]

@@ -1,0 +1,217 @@
+//! Controllers: the greedy maximum-acceleration autostrafer TAS tools use today (physics.md section 6),
+//! one-sided strafers, and playback of a planned sequence.
+
+use super::{Controller, Simulation, Trace};
+use crate::physics::strafe::{max_accel_control, strafe_keys};
+use crate::physics::{Control, Effect, PlayerState, Side, Vec2, Wish};
+
+/// The keys a controller holds for a scene: full sidemove, jump held when the scene jumps (autojump).
+fn scene_keys(sim: &Simulation) -> Wish {
+    let scene = sim.scene();
+    let mut keys = strafe_keys(scene.vars.side_key_speed);
+    keys.jump = scene.effects.has(Effect::Jump);
+    keys
+}
+
+/// Maximum acceleration on one side every frame (`max-accel-left`, `max-accel-right`).
+#[derive(Clone, Copy, Debug)]
+pub struct SideStrafer {
+    /// The side turned to.
+    pub side: Side,
+}
+
+impl Controller for SideStrafer {
+    fn name(&self) -> String {
+        match self.side {
+            Side::Left => "max-accel-left".to_string(),
+            Side::Right => "max-accel-right".to_string(),
+        }
+    }
+
+    fn control(&mut self, _frame: u64, s: &PlayerState, sim: &Simulation) -> Control {
+        max_accel_control(sim.stepper(), s, scene_keys(sim), self.side, s.vel.angle())
+    }
+}
+
+/// Plays a fixed control sequence; after its end, repeats the last control.
+#[derive(Clone, Debug)]
+pub struct Playback {
+    /// The controls, frame 1 first.
+    pub controls: Vec<Control>,
+    /// Name for reports.
+    pub label: String,
+}
+
+impl Controller for Playback {
+    fn name(&self) -> String {
+        self.label.clone()
+    }
+
+    fn control(&mut self, frame: u64, s: &PlayerState, _sim: &Simulation) -> Control {
+        let i = usize::try_from(frame.saturating_sub(1)).unwrap_or(usize::MAX);
+        self.controls
+            .get(i)
+            .or(self.controls.last())
+            .copied()
+            .unwrap_or(Control::strafe(s.vel, 0.0, 0.0, 0.0, 0.0))
+    }
+}
+
+/// The greedy autostrafer: maximum acceleration every frame, steering only by the side, which is chosen
+/// to turn the velocity towards a point up to `lookahead_units` ahead along a guide path (the corridor's
+/// shortest path), the furthest such point the hull can reach in a straight line (the look-ahead is
+/// halved until the line is clear, so it never aims across a corner). When velocity and target agree it
+/// alternates sides, which holds a straight line.
+#[derive(Clone, Debug)]
+pub struct Greedy {
+    path: Vec<Vec2>,
+    cumulative: Vec<f64>,
+    lookahead_units: f64,
+    last_side: Side,
+}
+
+impl Greedy {
+    /// A greedy strafer following `path` (at least one point) with the given look-ahead distance.
+    pub fn new(path: Vec<Vec2>, lookahead_units: f64) -> Self {
+        let mut cumulative = Vec::with_capacity(path.len());
+        let mut total = 0.0;
+        for (i, p) in path.iter().enumerate() {
+            if i > 0 {
+                total += (*p - path[i - 1]).length();
+            }
+            cumulative.push(total);
+        }
+        Greedy {
+            path,
+            cumulative,
+            lookahead_units,
+            last_side: Side::Right,
+        }
+    }
+
+    /// The look-ahead distance, units.
+    pub fn lookahead_units(&self) -> f64 {
+        self.lookahead_units
+    }
+
+    /// Arc length along the path of the point nearest to `p`.
+    fn project(&self, p: Vec2) -> f64 {
+        let mut best = (f64::INFINITY, 0.0);
+        for i in 1..self.path.len() {
+            let (a, b) = (self.path[i - 1], self.path[i]);
+            let ab = b - a;
+            let len2 = ab.length_squared();
+            let t = if len2 > 0.0 {
+                ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let d = (a + ab * t - p).length_squared();
+            if d < best.0 {
+                best = (d, self.cumulative[i - 1] + t * len2.sqrt());
+            }
+        }
+        best.1
+    }
+
+    /// The point at arc length `s`, continuing straight past the path's end.
+    fn point_at(&self, s: f64) -> Vec2 {
+        let n = self.path.len();
+        if n == 1 {
+            return self.path[0];
+        }
+        for i in 1..n {
+            if s <= self.cumulative[i] || i == n - 1 {
+                let (a, b) = (self.path[i - 1], self.path[i]);
+                let seg = self.cumulative[i] - self.cumulative[i - 1];
+                let t = if seg > 0.0 {
+                    (s - self.cumulative[i - 1]) / seg
+                } else {
+                    0.0
+                };
+                return a + (b - a) * t;
+            }
+        }
+        self.path[n - 1]
+    }
+}
+
+impl Controller for Greedy {
+    fn name(&self) -> String {
+        "greedy".to_string()
+    }
+
+    fn control(&mut self, _frame: u64, s: &PlayerState, sim: &Simulation) -> Control {
+        let here = self.project(s.pos);
+        let mut lookahead = self.lookahead_units;
+        let mut target = self.point_at(here + lookahead);
+        for _ in 0..MAX_LOOKAHEAD_HALVINGS {
+            if sim.clear_line(s.pos, target) {
+                break;
+            }
+            lookahead *= 0.5;
+            target = self.point_at(here + lookahead);
+        }
+        let to_target = target - s.pos;
+        let turn = s.vel.cross(to_target);
+        // Turn towards the target; when already aligned, alternate sides to hold the line.
+        let side = if turn > 0.0 || (turn == 0.0 && self.last_side == Side::Right) {
+            Side::Left
+        } else {
+            Side::Right
+        };
+        self.last_side = side;
+        max_accel_control(sim.stepper(), s, scene_keys(sim), side, to_target.angle())
+    }
+}
+
+/// How often the greedy strafer halves its look-ahead looking for a target in plain sight.
+const MAX_LOOKAHEAD_HALVINGS: usize = 12;
+
+/// Look-ahead distances tried by [`best_greedy`], units: 24 steps of 1.25x from 25 to about 4700.
+pub const GREEDY_LOOKAHEADS_UNITS: [f64; 24] = {
+    let mut v = [0.0; 24];
+    let mut x = 25.0;
+    let mut i = 0;
+    while i < 24 {
+        v[i] = x;
+        x *= 1.25;
+        i += 1;
+    }
+    v
+};
+
+/// Runs the greedy strafer with each look-ahead distance and keeps the best run: the earliest feasible
+/// crossing, else the earliest crossing, else the run that got furthest along the path. Returns the trace
+/// and the look-ahead used.
+pub fn best_greedy(sim: &Simulation, path: &[Vec2], lookaheads: &[f64]) -> (Trace, f64) {
+    let guide = Greedy::new(path.to_vec(), 0.0);
+    let mut best: Option<((u8, f64), Trace, f64)> = None;
+    for &la in lookaheads {
+        let t = sim.run(&mut Greedy::new(path.to_vec(), la));
+        let r = rank(&t, &guide);
+        if best.as_ref().is_none_or(|(b, _, _)| r < *b) {
+            best = Some((r, t, la));
+        }
+    }
+    match best {
+        Some((_, t, la)) => (t, la),
+        None => {
+            let la = GREEDY_LOOKAHEADS_UNITS[9];
+            (sim.run(&mut Greedy::new(path.to_vec(), la)), la)
+        }
+    }
+}
+
+/// Sort key of a run: feasible crossings first by time, then infeasible crossings by time, then the rest
+/// by how far along the guide path they ended (further is better).
+fn rank(t: &Trace, guide: &Greedy) -> (u8, f64) {
+    match (t.crossing, t.feasible()) {
+        (Some(c), true) => (0, c.time),
+        (Some(c), false) => (1, c.time),
+        (None, _) => {
+            let end = t.frames.last().map_or(t.start.pos, |f| f.pos);
+            (2, -guide.project(end))
+        }
+    }
+}

@@ -1,0 +1,159 @@
+//! Simulation of a scene (physics.md sections 3 and 10): one frame loop, [`Simulation::run`], owns the
+//! walls, the rule lines, the finish line and the frame cap; [`Controller`]s only choose each frame's
+//! control (as argmin's `Solver` leaves the loop to its `Executor`).
+//!
+//! Each frame: the controller picks a [`Control`], the stepper runs steps 1-4, the hull is swept through
+//! the solid walls (or moved freely), steps 5-6 follow, then rule lines are checked along the frame's
+//! straight move and the finish crossing is found with its fraction inside the frame.
+
+pub mod controllers;
+pub mod trace;
+
+use crate::error::Result;
+use crate::geometry::{BoundaryKind, Corridor};
+use crate::physics::{Control, Effect, PlayerState, Stepper, Vec2};
+use crate::scene::Scene;
+pub use controllers::{Greedy, Playback, SideStrafer};
+pub use trace::{Crossing, FrameRecord, Trace};
+
+/// Chooses the control of each frame from the state before it.
+pub trait Controller {
+    /// A short name for reports (`greedy`, `max-accel-left`).
+    fn name(&self) -> String;
+    /// The control of frame `frame` (1-based) given the state before it.
+    fn control(&mut self, frame: u64, state: &PlayerState, sim: &Simulation) -> Control;
+}
+
+/// A scene ready to simulate: its stepper (only the scene's effects) and its corridor, built once.
+pub struct Simulation<'s> {
+    scene: &'s Scene,
+    stepper: Stepper<f64>,
+    corridor: Corridor,
+    solid_walls: bool,
+    rule_walls: bool,
+}
+
+impl<'s> Simulation<'s> {
+    /// Prepares `scene` for simulation.
+    pub fn new(scene: &'s Scene) -> Result<Self> {
+        let corridor = scene.corridor()?;
+        let solid_walls = scene.effects.has(Effect::Walls) && corridor.has(BoundaryKind::Solid);
+        let rule_walls = corridor.has(BoundaryKind::Rule);
+        Ok(Simulation {
+            scene,
+            stepper: Stepper::new(&scene.vars, scene.effects),
+            corridor,
+            solid_walls,
+            rule_walls,
+        })
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Scene {
+        self.scene
+    }
+
+    /// The frame stepper.
+    pub fn stepper(&self) -> &Stepper<f64> {
+        &self.stepper
+    }
+
+    /// The corridor.
+    pub fn corridor(&self) -> &Corridor {
+        &self.corridor
+    }
+
+    /// True when the hull can move straight from `p0` to `p1` without crossing into a rule boundary or
+    /// hitting a solid wall (touching is allowed).
+    pub fn clear_line(&self, p0: Vec2, p1: Vec2) -> bool {
+        if self.rule_walls && self.corridor.rule_violation_swept(p0, p1) {
+            return false;
+        }
+        !(self.solid_walls
+            && matches!(
+                self.corridor.cast(p0, p1 - p0),
+                crate::geometry::Cast::Hit(_) | crate::geometry::Cast::StartedInside { .. }
+            ))
+    }
+
+    /// One frame from `s` with control `c`: the step, the swept move, the rule check. Returns the number
+    /// of wall contacts and whether a rule line was crossed.
+    #[inline]
+    pub fn frame(&self, s: &mut PlayerState, c: &Control) -> FrameOutcome {
+        let before = s.pos;
+        let wish = c.wish();
+        self.stepper.pre_move(s, &wish);
+        let mut contacts = 0;
+        if self.solid_walls {
+            let r = self
+                .corridor
+                .sweep(s.pos, s.vel, self.stepper.frame_time_s());
+            s.pos = r.pos;
+            s.vel = r.vel;
+            contacts = r.status.contacts();
+        } else {
+            s.pos += s.vel * self.stepper.frame_time_s();
+        }
+        self.stepper.post_move(s);
+        let broke_rule = self.rule_walls && self.corridor.rule_violation_swept(before, s.pos);
+        FrameOutcome {
+            from: before,
+            contacts,
+            broke_rule,
+        }
+    }
+
+    /// Runs `controller` from the scene's start until the finish line is crossed or the frame cap.
+    pub fn run(&self, controller: &mut dyn Controller) -> Trace {
+        let tau = self.stepper.frame_time_s();
+        let mut s = self.scene.start;
+        let mut trace = Trace::new(controller.name(), &s, self.corridor.clearance(s.pos));
+        for frame in 1..=self.scene.max_frames {
+            let c = controller.control(frame, &s, self);
+            let theta = c.theta_rad(s.vel);
+            let out = self.frame(&mut s, &c);
+            let crossing = self
+                .scene
+                .finish
+                .crossing_fraction(out.from, s.pos)
+                .map(|f| Crossing::new(frame, f, tau));
+            trace.push(
+                FrameRecord {
+                    frame,
+                    time: frame as f64 * tau,
+                    pos: s.pos,
+                    vel: s.vel,
+                    speed: s.speed(),
+                    yaw_rad: c.yaw_rad,
+                    theta_rad: theta,
+                    on_ground: s.on_ground,
+                    ducked: s.ducked,
+                    clearance: self.corridor.clearance(s.pos),
+                    contacts: out.contacts,
+                    broke_rule: out.broke_rule,
+                },
+                c,
+            );
+            if let Some(c) = crossing {
+                trace.crossing = Some(c);
+                break;
+            }
+            if !s.is_finite() {
+                trace.numerical_failure = true;
+                break;
+            }
+        }
+        trace
+    }
+}
+
+/// What one frame did besides moving the state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameOutcome {
+    /// Hull centre before the frame.
+    pub from: Vec2,
+    /// Wall contacts of the swept move.
+    pub contacts: u32,
+    /// The straight move crossed into a rule boundary.
+    pub broke_rule: bool,
+}
