@@ -20,6 +20,64 @@ pub enum Command {
     Calc(CalcArgs),
     /// Simulate a scene with a controller; print its time beside the lower bound.
     Simulate(SimulateArgs),
+    /// Find the minimal-time control sequence through a scene.
+    Solve(SolveArgs),
+    /// Turn a saved `--json` result into a self-contained HTML report.
+    Report(ReportArgs),
+}
+
+/// Output files every run can write besides `--trajectory`.
+#[derive(Debug, Args, Clone, Default)]
+pub struct ArtifactFlags {
+    /// Write the trajectory, one row per frame (`.csv`, or `.json` for JSON).
+    #[arg(long)]
+    pub trajectory: Option<PathBuf>,
+    /// Write a self-contained HTML report with figures.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Write the plan as a Bunnymod XT TAS script (GoldSrc scenes).
+    #[arg(long)]
+    pub hltas: Option<PathBuf>,
+}
+
+/// Accuracy levels of `solve`, cheapest first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum QualityArg {
+    /// Coarse: few iterations, the relaxed problem only.
+    Fast,
+    /// The default: relaxed, then exact sides.
+    Balanced,
+    /// Exact sides polished to convergence, checked in engine-exact mode.
+    Exact,
+}
+
+/// `strafeopt solve SCENE ...`
+#[derive(Debug, Args)]
+pub struct SolveArgs {
+    /// The scene file (TOML).
+    pub scene: PathBuf,
+    /// How hard to work.
+    #[arg(long, value_enum, default_value_t = QualityArg::Balanced)]
+    pub quality: QualityArg,
+    /// Stop after this many seconds with the best valid plan so far.
+    #[arg(long, allow_negative_numbers = true)]
+    pub time_limit: Option<f64>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub artifacts: ArtifactFlags,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub output: OutputFlags,
+}
+
+/// `strafeopt report RESULT.json -o out.html`
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// A result saved from `simulate --json` or `solve --json`.
+    pub result: PathBuf,
+    /// Where to write the HTML.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
 }
 
 /// Controllers `simulate` can run.
@@ -44,9 +102,9 @@ pub struct SimulateArgs {
     /// Greedy look-ahead distance, units (default: the best of a sweep from 25 to 1200).
     #[arg(long, allow_negative_numbers = true)]
     pub lookahead: Option<f64>,
-    /// Write the trajectory, one row per frame (`.csv`, or `.json` for JSON).
-    #[arg(long)]
-    pub trajectory: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub artifacts: ArtifactFlags,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub output: OutputFlags,

@@ -4,7 +4,9 @@
 
 pub mod args;
 pub mod calc;
+pub mod report_cmd;
 pub mod simulate;
+pub mod solve;
 
 use crate::error::Error;
 use args::{Cli, Command};
@@ -91,6 +93,8 @@ pub fn main_with_args(argv: impl IntoIterator<Item = std::ffi::OsString>) -> u8 
 pub fn run(cli: &Cli) -> Result<String, Error> {
     match &cli.command {
         Command::Simulate(a) => simulate::run(a),
+        Command::Solve(a) => solve::run(a),
+        Command::Report(a) => report_cmd::run(a),
         Command::Calc(c) => {
             let figures = calc::run(&c.form)?;
             if calc::wants_json(&c.form) {

@@ -32,7 +32,7 @@ pub fn run(args: &SimulateArgs) -> Result<String> {
         ControllerArg::MaxAccelLeft => (sim.run(&mut SideStrafer { side: Side::Left }), None),
         ControllerArg::MaxAccelRight => (sim.run(&mut SideStrafer { side: Side::Right }), None),
     };
-    if let Some(path) = &args.trajectory {
+    if let Some(path) = &args.artifacts.trajectory {
         let json = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
