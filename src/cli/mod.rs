@@ -10,7 +10,7 @@ pub mod solve;
 
 use crate::error::Error;
 use args::{Cli, Command};
-use clap::Parser;
+use clap::{CommandFactory, Parser};
 use std::io::Write;
 
 /// Exit code for success.
@@ -35,29 +35,30 @@ pub fn exit_code(e: &Error) -> u8 {
 
 /// Runs the program on `argv` and returns the exit code.
 pub fn main_with_args(argv: impl IntoIterator<Item = std::ffi::OsString>) -> u8 {
-    let cli = match Cli::try_parse_from(argv) {
+    let argv: Vec<std::ffi::OsString> = argv.into_iter().collect();
+    let cli = match Cli::try_parse_from(&argv) {
         Ok(cli) => cli,
         Err(e) => {
             use clap::error::ErrorKind;
-            if matches!(
-                e.kind(),
-                ErrorKind::DisplayHelp
-                    | ErrorKind::DisplayVersion
-                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
-            ) {
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
                 let _ = e.print();
-                return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
-                    EXIT_BAD_INPUT
-                } else {
-                    EXIT_OK
-                };
+                return EXIT_OK;
             }
-            // One line: clap's message up to its usage block, without the "error: " prefix.
+            if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                // An error like any other: one line, not the whole help.
+                eprintln!("strafeopt: {}", missing_command(&argv));
+                return EXIT_BAD_INPUT;
+            }
+            // One line: clap's message up to its usage block or hint, without the "error: " prefix.
             let rendered = e.render().to_string();
             let message: Vec<&str> = rendered
                 .lines()
                 .map(str::trim)
-                .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("tip:"))
+                .take_while(|l| {
+                    !l.starts_with("Usage:")
+                        && !l.starts_with("tip:")
+                        && !l.starts_with("For more information")
+                })
                 .filter(|l| !l.is_empty())
                 .collect();
             let line = message.join(" ");
@@ -87,6 +88,29 @@ pub fn main_with_args(argv: impl IntoIterator<Item = std::ffi::OsString>) -> u8 
             exit_code(&e)
         }
     }
+}
+
+/// The message for a command line that stops before naming its (sub)command: `strafeopt` alone, or
+/// `strafeopt calc` without a figure.
+fn missing_command(argv: &[std::ffi::OsString]) -> String {
+    let mut cmd = Cli::command();
+    let mut path = vec![cmd.get_name().to_string()];
+    for arg in argv.iter().skip(1).filter_map(|a| a.to_str()) {
+        if let Some(sub) = cmd.find_subcommand(arg).cloned() {
+            path.push(sub.get_name().to_string());
+            cmd = sub;
+        }
+    }
+    let names: Vec<&str> = cmd
+        .get_subcommands()
+        .map(|c| c.get_name())
+        .filter(|&n| n != "help")
+        .collect();
+    format!(
+        "`{}` needs a command: {} (see --help)",
+        path.join(" "),
+        names.join(", ")
+    )
 }
 
 /// Runs a parsed command and returns what to print.

@@ -46,7 +46,8 @@ impl FinishLine {
     ///
     /// Touching counts (a move ending exactly on the line crosses it at fraction 1) and so does a start on
     /// the line (fraction 0). The test is made with [`CONTACT_TOL_UNITS`] of slack; the fraction returned is
-    /// the exact one, clamped to `[0, 1]`.
+    /// the exact one, clamped to `[0, 1]`. A move with a NaN or infinite end crosses nothing (it is a
+    /// numerical failure, not a finish).
     pub fn crossing_fraction_with(
         &self,
         p0: Vec2,
@@ -54,6 +55,9 @@ impl FinishLine {
         point: FinishPoint,
         half_width_units: f64,
     ) -> Option<f64> {
+        if !(p0.is_finite() && p1.is_finite()) {
+            return None;
+        }
         let h = match point {
             FinishPoint::Centre => 0.0,
             FinishPoint::Hull => half_width_units.max(0.0),

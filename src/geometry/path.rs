@@ -45,9 +45,10 @@ impl Corridor {
         for g in &obstacles {
             nodes.extend(g.vertices().into_iter().filter(|&v| !inside_any(v)));
         }
+        let (ta, te) = (to_segment.0, to_segment.1 - to_segment.0);
         for &(s0, s1) in &targets {
-            nodes.push(s0);
-            nodes.push(s1);
+            nodes.push(ta + te * s0);
+            nodes.push(ta + te * s1);
         }
 
         // Dense Dijkstra; node `n` is the virtual terminal, reached from any node by its best last leg.
@@ -69,7 +70,7 @@ impl Corridor {
             let pu = nodes[u];
             // Best last leg from u: the nearest point of each stretch, if in sight.
             for &(s0, s1) in &targets {
-                let foot = closest_on_segment(pu, s0, s1);
+                let foot = ta + te * closest_parameter(pu, ta, te).max(s0).min(s1);
                 let d = dist[u] + (foot - pu).length();
                 if d < dist[terminal] && !blocked(pu, foot) {
                     dist[terminal] = d;
@@ -100,19 +101,20 @@ impl Corridor {
     }
 }
 
-/// The closest point to `p` on the segment `a`-`b`.
-fn closest_on_segment(p: Vec2, a: Vec2, b: Vec2) -> Vec2 {
-    let e = b - a;
+/// The parameter `t` of the point `a + t e` nearest to `p` on the line through `a` along `e` (0 when `e`
+/// is zero). Measured on the whole target segment, not on a stretch of it, so that a foot in the middle of
+/// a stretch is not moved by the rounding of the stretch's ends.
+fn closest_parameter(p: Vec2, a: Vec2, e: Vec2) -> f64 {
     let len2 = e.length_squared();
     if len2 == 0.0 {
-        return a;
+        return 0.0;
     }
-    let t = ((p - a).dot(e) / len2).clamp(0.0, 1.0);
-    a + e * t
+    (p - a).dot(e) / len2
 }
 
-/// The parts of the segment `(a, b)` outside every (shrunk) grown wall, as closed sub-segments.
-fn reachable_stretches(obstacles: &[&GrownSegment], (a, b): (Vec2, Vec2)) -> Vec<(Vec2, Vec2)> {
+/// The parts of the segment `(a, b)` outside every (shrunk) grown wall, as closed parameter intervals
+/// `[s0, s1]` of `a + s (b - a)`.
+fn reachable_stretches(obstacles: &[&GrownSegment], (a, b): (Vec2, Vec2)) -> Vec<(f64, f64)> {
     if !(a.is_finite() && b.is_finite()) {
         return Vec::new();
     }
@@ -121,7 +123,11 @@ fn reachable_stretches(obstacles: &[&GrownSegment], (a, b): (Vec2, Vec2)) -> Vec
         let outside = obstacles
             .iter()
             .all(|g| g.max_side(a) >= -PATH_SHRINK_UNITS);
-        return if outside { vec![(a, a)] } else { Vec::new() };
+        return if outside {
+            vec![(0.0, 0.0)]
+        } else {
+            Vec::new()
+        };
     }
     // Open intervals of the parameter in (0, 1) covered by grown walls.
     let mut covered: Vec<(f64, f64)> = obstacles
@@ -144,7 +150,5 @@ fn reachable_stretches(obstacles: &[&GrownSegment], (a, b): (Vec2, Vec2)) -> Vec
     if t < 1.0 {
         free.push((t, 1.0));
     }
-    free.into_iter()
-        .map(|(s0, s1)| (a + e * s0, a + e * s1))
-        .collect()
+    free
 }

@@ -65,13 +65,16 @@ impl Effect {
         }
     }
 
-    /// The effect another effect needs, if any (`jump` needs `gravity`).
-    pub fn requires(self) -> Option<Effect> {
+    /// The effects this one needs (`jump` needs `gravity`). The Source jump boost also needs the
+    /// velocity clamp: backhops double the excess speed every hop (physics.md section 11), and only
+    /// `sv_maxvelocity` stops that reaching infinity.
+    pub fn requires(self) -> &'static [Effect] {
         match self {
-            Effect::EdgeFriction => Some(Effect::Friction),
-            Effect::Jump => Some(Effect::Gravity),
-            Effect::BhopCap | Effect::JumpBoost => Some(Effect::Jump),
-            _ => None,
+            Effect::EdgeFriction => &[Effect::Friction],
+            Effect::Jump => &[Effect::Gravity],
+            Effect::BhopCap => &[Effect::Jump],
+            Effect::JumpBoost => &[Effect::Jump, Effect::MaxVelocity],
+            _ => &[],
         }
     }
 
@@ -133,9 +136,12 @@ impl Effects {
 
     /// The first effect present whose requirement is missing, with that requirement.
     pub fn missing_requirement(self) -> Option<(Effect, Effect)> {
-        self.list()
-            .into_iter()
-            .find_map(|e| e.requires().filter(|&r| !self.has(r)).map(|r| (e, r)))
+        self.list().into_iter().find_map(|e| {
+            e.requires()
+                .iter()
+                .find(|&&r| !self.has(r))
+                .map(|&r| (e, r))
+        })
     }
 
     /// True when only air acceleration, the velocity clamp and walls are asked for: the frame is then just

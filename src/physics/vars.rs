@@ -64,6 +64,15 @@ pub const FRICTION_MIN_SPEED_UPS: f64 = 0.1;
 /// After a ground move, a speed below this (ups) is set to zero (`PM_WalkMove`, `CGameMovement::WalkMove`).
 pub const WALK_STOP_SPEED_UPS: f64 = 1.0;
 
+/// Largest magnitude of any movement variable: far beyond any game's settings, small enough that no run
+/// overflows.
+pub const MAX_SETTING_MAGNITUDE: f64 = 1e6;
+/// Fewest frames per second accepted.
+pub const MIN_FPS: f64 = 1.0;
+/// Most frames per second accepted (a frame time of 10 microseconds; the default frame cap of 60 s is then
+/// six million frames).
+pub const MAX_FPS: f64 = 1e5;
+
 /// The movement variables of physics.md section 2, in ups, ups^2, seconds.
 ///
 /// Build one from a [`Preset`] and change any field through [`VarOverrides`], which validates.
@@ -188,10 +197,19 @@ impl MovementVars {
         self.friction * self.entity_friction * ef
     }
 
-    /// Checks every field; the error names the field and its allowed range.
+    /// Checks every field; the error names the field and its allowed range. Besides each field's sign,
+    /// every magnitude is bounded ([`MAX_SETTING_MAGNITUDE`], fps in [`MIN_FPS`, `MAX_FPS`]), so no run of
+    /// the default frame cap can overflow `f64`: a finite `1e308` acceleration would reach infinity in a frame.
     pub fn validate(&self) -> Result<()> {
         let tau = self.frame_time_s();
         require_positive("fps", self.fps)?;
+        if !(MIN_FPS..=MAX_FPS).contains(&self.fps) {
+            return Err(Error::invalid(
+                "fps",
+                self.fps,
+                format!("between {MIN_FPS} and {MAX_FPS} frames per second"),
+            ));
+        }
         if !(tau.is_finite() && tau > 0.0) {
             return Err(Error::invalid(
                 "fps",
@@ -212,7 +230,32 @@ impl MovementVars {
         require_non_negative("forward-key-speed", self.forward_key_speed)?;
         require_non_negative("side-key-speed", self.side_key_speed)?;
         require_non_negative("duck-multiplier", self.duck_multiplier)?;
-        require_non_negative("unduck-time", self.unduck_time_s)?;
+        require_non_negative("unduck-time-s", self.unduck_time_s)?;
+        let magnitudes = [
+            ("maxspeed", self.maxspeed),
+            ("accelerate", self.accelerate),
+            ("airaccelerate", self.airaccelerate),
+            ("friction", self.friction),
+            ("edgefriction", self.edgefriction),
+            ("entity-friction", self.entity_friction),
+            ("stopspeed", self.stopspeed),
+            ("maxvelocity", self.maxvelocity),
+            ("gravity", self.gravity),
+            ("air-speed-cap", self.air_speed_cap),
+            ("forward-key-speed", self.forward_key_speed),
+            ("side-key-speed", self.side_key_speed),
+            ("duck-multiplier", self.duck_multiplier),
+            ("unduck-time-s", self.unduck_time_s),
+        ];
+        for (name, v) in magnitudes {
+            if v.abs() > MAX_SETTING_MAGNITUDE {
+                return Err(Error::invalid(
+                    name,
+                    v,
+                    format!("at most {MAX_SETTING_MAGNITUDE:e} in magnitude"),
+                ));
+            }
+        }
         Ok(())
     }
 }

@@ -32,7 +32,7 @@ impl<'t> KeyIndex<'t> {
         let mut entries = Vec::new();
         walk_table(doc.get_ref(), "", &mut entries);
         KeyIndex {
-            origin: origin.to_string(),
+            origin: one_line(origin),
             text,
             entries,
         }
@@ -41,7 +41,7 @@ impl<'t> KeyIndex<'t> {
     /// An index that knows no keys (errors then carry the file name alone).
     pub fn empty(origin: &str, text: &'t str) -> Self {
         KeyIndex {
-            origin: origin.to_string(),
+            origin: one_line(origin),
             text,
             entries: Vec::new(),
         }
@@ -100,8 +100,8 @@ impl<'t> KeyIndex<'t> {
     pub fn error_at(&self, path: &str, locate_at: &str, message: impl Into<String>) -> Error {
         Error::Scene {
             location: self.location(locate_at),
-            key: path.to_string(),
-            message: message.into(),
+            key: one_line(path),
+            message: one_line(&message.into()),
         }
     }
 
@@ -122,7 +122,7 @@ impl<'t> KeyIndex<'t> {
         Error::Scene {
             location,
             key,
-            message: friendly(e.message()),
+            message: one_line(&friendly(e.message())),
         }
     }
 }
@@ -135,10 +135,12 @@ fn parent(path: &str) -> Option<&str> {
 
 fn walk_table(table: &DeTable<'_>, prefix: &str, out: &mut Vec<Entry>) {
     for (k, v) in table.iter() {
+        // A quoted key may hold any character; written as an escape, a line break cannot split a message.
+        let name = one_line(k.get_ref());
         let path = if prefix.is_empty() {
-            k.get_ref().to_string()
+            name
         } else {
-            format!("{prefix}.{}", k.get_ref())
+            format!("{prefix}.{name}")
         };
         out.push(Entry {
             path: path.clone(),
@@ -165,6 +167,25 @@ fn walk_value(value: &DeValue<'_>, path: &str, out: &mut Vec<Entry>) {
         }
         _ => {}
     }
+}
+
+/// `text` with every character that would break an error's one line (control characters such as `\n`,
+/// `\r` or NUL, and the Unicode line and paragraph separators) written as its escape (`\n`, `\u{2028}`).
+/// File names, quoted keys and string values can hold any of them.
+pub(crate) fn one_line(text: &str) -> String {
+    let breaks = |c: char| c.is_control() || matches!(c, '\u{2028}' | '\u{2029}');
+    if !text.contains(breaks) {
+        return text.to_string();
+    }
+    text.chars()
+        .map(|c| {
+            if breaks(c) {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 /// The TOML reader's message in the words of a scene file (`f64` -> `a number`).

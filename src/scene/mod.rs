@@ -56,6 +56,16 @@ use std::path::Path;
 /// Default frame cap of a run, as a time: `max-frames = ceil(DEFAULT_MAX_TIME_S * fps)`.
 pub const DEFAULT_MAX_TIME_S: f64 = 60.0;
 
+/// Largest magnitude of any coordinate of a scene (walls, shorthand shapes, start, finish), units. The
+/// contact tolerance of 1e-9 units must stay representable (`f64` spacing is 1.2e-10 at 1e6), and segment
+/// lengths and clearances must not overflow; no map comes near it (GoldSrc maps span +-4096 units, Source
+/// maps +-16384).
+pub const MAX_COORDINATE_UNITS: f64 = 1e6;
+
+/// Largest start speed, ups: far beyond any reachable speed (`sv_maxvelocity` clamps each component at 2000
+/// ups in Half-Life, 3500 in Half-Life 2), and small enough that no position of a run overflows.
+pub const MAX_START_SPEED_UPS: f64 = 1e6;
+
 /// A validated scene: everything a simulation needs.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Scene {
@@ -92,7 +102,7 @@ impl Scene {
     pub fn load(path: &Path) -> Result<Scene> {
         let origin = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| Error::Scene {
-            location: origin.clone(),
+            location: locate::one_line(&origin),
             key: "-".to_string(),
             message: format!("cannot read the file: {e}"),
         })?;

@@ -3,10 +3,11 @@
 use super::file::{Point, SceneFile};
 use super::locate::KeyIndex;
 use super::shorthand::{BadParam, Expanded};
-use super::{Scene, DEFAULT_MAX_TIME_S};
+use super::{Scene, DEFAULT_MAX_TIME_S, MAX_COORDINATE_UNITS, MAX_START_SPEED_UPS};
 use crate::error::{Error, Result};
 use crate::geometry::{
-    BoundaryKind, Corridor, FinishLine, Wall, CONTACT_TOL_UNITS, MIN_SEGMENT_LENGTH_UNITS,
+    BoundaryKind, Corridor, FinishLine, Wall, WallDefect, CONTACT_TOL_UNITS,
+    MIN_SEGMENT_LENGTH_UNITS,
 };
 use crate::physics::{Effect, Effects, MovementVars, PlayerState, Vec2};
 use serde::Deserialize;
@@ -75,16 +76,46 @@ fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
         wall_keys.push(format!("walls[{i}]"));
     }
     for (wall, key) in walls.iter().zip(&wall_keys) {
-        if let Some(defect) = wall.defect() {
-            let points_key = if key.starts_with("walls[") {
-                format!("{key}.points")
+        let points_key = if key.starts_with("walls[") {
+            format!("{key}.points")
+        } else {
+            key.clone()
+        };
+        // The point `i` of this wall in messages: its own line for a file's wall, else the shape's.
+        let point_key = |i: usize| {
+            if key.starts_with("walls[") {
+                format!("{points_key}[{i}]")
             } else {
-                key.clone()
+                points_key.clone()
+            }
+        };
+        let defect = wall.defect();
+        // Too few or non-finite points first; then the range, before any shape test measures lengths.
+        let out_of_range = wall.points.iter().position(|&p| !within_range(p));
+        if let (
+            None | Some(WallDefect::ZeroLength { .. } | WallDefect::SelfIntersection { .. }),
+            Some(i),
+        ) = (defect, out_of_range)
+        {
+            let q = wall.points[i];
+            let what = if key.starts_with("walls[") {
+                format!("point {i} is at")
+            } else {
+                format!("[{key}] reaches")
             };
-            let locate_at = match defect.point() {
-                Some(p) if key.starts_with("walls[") => format!("{points_key}[{p}]"),
-                _ => points_key.clone(),
-            };
+            return Err(ix.error_at(
+                &points_key,
+                &point_key(i),
+                format!(
+                    "{what} ({}, {}); every coordinate must be between -{MAX_COORDINATE_UNITS} and \
+                     {MAX_COORDINATE_UNITS} units",
+                    short(q.x),
+                    short(q.y),
+                ),
+            ));
+        }
+        if let Some(defect) = defect {
+            let locate_at = defect.point().map_or(points_key.clone(), point_key);
             return Err(ix.error_at(&points_key, &locate_at, defect.to_string()));
         }
         if wall.kind == BoundaryKind::Solid && !effects.has(Effect::Walls) {
@@ -201,11 +232,35 @@ fn engine_error(ix: &KeyIndex<'_>, e: Error) -> Error {
     }
 }
 
-fn finite_point(ix: &KeyIndex<'_>, key: &str, p: Point) -> Result<Vec2> {
-    if p.0.is_finite() {
+/// True when both coordinates are finite and within [`MAX_COORDINATE_UNITS`].
+fn within_range(p: Vec2) -> bool {
+    p.x.abs() <= MAX_COORDINATE_UNITS && p.y.abs() <= MAX_COORDINATE_UNITS
+}
+
+/// A number for a message: plain when moderate, in exponent form when huge or tiny (`1e300`, not 301
+/// digits).
+fn short(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-6..1e9).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// A position `[x, y]`: finite and within [`MAX_COORDINATE_UNITS`].
+fn position(ix: &KeyIndex<'_>, key: &str, p: Point) -> Result<Vec2> {
+    if within_range(p.0) {
         Ok(p.0)
     } else {
-        Err(ix.error(key, "must be two finite numbers"))
+        Err(ix.error(
+            key,
+            format!(
+                "got [{}, {}]; must be two finite numbers, each between -{MAX_COORDINATE_UNITS} and \
+                 {MAX_COORDINATE_UNITS} units",
+                short(p.0.x),
+                short(p.0.y),
+            ),
+        ))
     }
 }
 
@@ -219,7 +274,7 @@ fn start_state(
 ) -> Result<PlayerState> {
     let sf = file.start.clone().unwrap_or_default();
     let pos = match (sf.position, shape) {
-        (Some(p), _) => finite_point(ix, "start.position", p)?,
+        (Some(p), _) => position(ix, "start.position", p)?,
         (None, Some(s)) => s.expanded.start_position,
         (None, None) => {
             return Err(ix.error(
@@ -229,10 +284,36 @@ fn start_state(
         }
     };
     let vel = match (sf.velocity, shape) {
-        (Some(v), _) => finite_point(ix, "start.velocity", v)?,
+        (Some(v), _) => v.0,
         (None, Some(s)) => s.expanded.start_direction * vars.maxspeed,
         (None, None) => Vec2::ZERO,
     };
+    // Finite (a NaN fails the comparison) and at most MAX_START_SPEED_UPS (`hypot` cannot overflow).
+    let speed = vel.x.hypot(vel.y);
+    let speed_ok = speed <= MAX_START_SPEED_UPS;
+    if !speed_ok {
+        let (locate_at, what) = match (sf.velocity, shape) {
+            (None, Some(s)) => (
+                "engine.maxspeed",
+                format!(
+                    "the default start velocity (sv_maxspeed along [{}]) has speed {} ups",
+                    s.name,
+                    short(speed)
+                ),
+            ),
+            _ => (
+                "start.velocity",
+                format!("got [{}, {}]", short(vel.x), short(vel.y)),
+            ),
+        };
+        return Err(ix.error_at(
+            "start.velocity",
+            locate_at,
+            format!(
+                "{what}; must be two finite numbers with a speed of at most {MAX_START_SPEED_UPS} ups"
+            ),
+        ));
+    }
     let ducked = sf.ducked.unwrap_or(false);
     if ducked && !effects.has(Effect::Duck) {
         return Err(ix.error(
@@ -261,8 +342,8 @@ fn finish_line(
     let ((a, b), key) = match (ff.a, ff.b, shape) {
         (Some(a), Some(b), _) => (
             (
-                finite_point(ix, "finish.a", a)?,
-                finite_point(ix, "finish.b", b)?,
+                position(ix, "finish.a", a)?,
+                position(ix, "finish.b", b)?,
             ),
             "finish".to_string(),
         ),

@@ -103,6 +103,46 @@ impl<'s> Simulation<'s> {
         }
     }
 
+    /// Plays `controls` in the engine-exact mode (f32 state, anglemod yaw; physics.md section 1) through the
+    /// same walls, rule lines and finish line. The walls are queried in f64 on the f32 positions.
+    pub fn run_engine_exact(&self, controls: &[Control]) -> EngineRun {
+        use crate::physics::engine_exact::{engine_wish, from_engine_state, to_engine_state};
+        let game: Stepper<f32> = Stepper::new(&self.scene.vars, self.scene.effects);
+        let tau = f64::from(game.frame_time_s());
+        let mut g = to_engine_state(&self.scene.start);
+        let mut run = EngineRun {
+            crossing: None,
+            broke_rule: false,
+            min_clearance: self.corridor.clearance(self.scene.start.pos),
+            finite: true,
+        };
+        for (i, c) in controls.iter().enumerate() {
+            let before = from_engine_state(&g).pos;
+            game.pre_move(&mut g, &engine_wish(c));
+            if self.solid_walls {
+                let s = from_engine_state(&g);
+                let r = self.corridor.sweep(s.pos, s.vel, tau);
+                g.pos = crate::physics::V2::from_f64(r.pos);
+                g.vel = crate::physics::V2::from_f64(r.vel);
+            } else {
+                g.pos += g.vel * game.frame_time_s();
+            }
+            game.post_move(&mut g);
+            let after = from_engine_state(&g).pos;
+            run.finite &= g.is_finite();
+            run.broke_rule |= self.rule_walls && self.corridor.rule_violation_swept(before, after);
+            run.min_clearance = run.min_clearance.min(self.corridor.clearance(after));
+            if let Some(f) = self.scene.finish.crossing_fraction(before, after) {
+                run.crossing = Some(Crossing::new(i as u64 + 1, f, tau));
+                break;
+            }
+            if !run.finite {
+                break;
+            }
+        }
+        run
+    }
+
     /// Runs `controller` from the scene's start until the finish line is crossed or the frame cap.
     pub fn run(&self, controller: &mut dyn Controller) -> Trace {
         let tau = self.stepper.frame_time_s();
@@ -112,6 +152,11 @@ impl<'s> Simulation<'s> {
             let c = controller.control(frame, &s, self);
             let theta = c.theta_rad(s.vel);
             let out = self.frame(&mut s, &c);
+            if !s.is_finite() {
+                // The run stops at the last finite state; the failing frame is not recorded.
+                trace.numerical_failure = true;
+                break;
+            }
             let crossing = self
                 .scene
                 .finish
@@ -138,12 +183,28 @@ impl<'s> Simulation<'s> {
                 trace.crossing = Some(c);
                 break;
             }
-            if !s.is_finite() {
-                trace.numerical_failure = true;
-                break;
-            }
         }
         trace
+    }
+}
+
+/// A plan played in the engine-exact mode.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct EngineRun {
+    /// The finish crossing, if reached.
+    pub crossing: Option<Crossing>,
+    /// A frame's move crossed into a rule boundary.
+    pub broke_rule: bool,
+    /// Smallest clearance over the frame ends, units.
+    pub min_clearance: f64,
+    /// Every state stayed finite.
+    pub finite: bool,
+}
+
+impl EngineRun {
+    /// Reached the line without breaking a rule.
+    pub fn feasible(&self) -> bool {
+        self.crossing.is_some() && !self.broke_rule && self.finite
     }
 }
 
