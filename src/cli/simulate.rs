@@ -4,8 +4,8 @@ use super::args::{ControllerArg, SimulateArgs};
 use super::write_atomically;
 use crate::error::{Error, Result};
 use crate::optimise::lower_bound;
-use crate::physics::Side;
-use crate::report;
+use crate::physics::{Game, Side};
+use crate::report::{self, ReportInput};
 use crate::scene::Scene;
 use crate::sim::controllers::{best_greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{Greedy, SideStrafer, Simulation, Trace};
@@ -14,6 +14,9 @@ use serde_json::{json, Value};
 /// Runs `simulate` and returns what to print.
 pub fn run(args: &SimulateArgs) -> Result<String> {
     let scene = Scene::load(&args.scene)?;
+    if let Some(path) = &args.artifacts.hltas {
+        require_goldsrc_for_hltas(&scene, path)?;
+    }
     let sim = Simulation::new(&scene)?;
     let bound = lower_bound(&scene, sim.corridor())?;
     let (trace, lookahead) = match args.controller {
@@ -45,6 +48,18 @@ pub fn run(args: &SimulateArgs) -> Result<String> {
         })?;
     }
     let summary = summary_json(&scene, &trace, &bound, lookahead);
+    if let Some(path) = &args.artifacts.report {
+        let input = ReportInput::new(&scene, &bound, &summary).with_run(&trace.controller, &trace);
+        write_atomically(path, |w| report::write_html(&input, w))?;
+    }
+    if let Some(path) = &args.artifacts.hltas {
+        let script = report::hltas_script(&trace, &scene.vars, &scene.name)?;
+        write_atomically(path, |w| {
+            script
+                .to_writer(w)
+                .map_err(|e| std::io::Error::other(format!("{e:?}")))
+        })?;
+    }
     if args.output.json {
         Ok(format!("{summary}\n"))
     } else {
@@ -52,11 +67,37 @@ pub fn run(args: &SimulateArgs) -> Result<String> {
     }
 }
 
+/// `--hltas` writes Bunnymod XT scripts, which replay Half-Life only: a Source scene is refused before
+/// anything runs, with one line naming the flag.
+pub fn require_goldsrc_for_hltas(scene: &Scene, path: &std::path::Path) -> Result<()> {
+    if scene.vars.game == Game::GoldSrc {
+        return Ok(());
+    }
+    Err(Error::InvalidValue {
+        name: "--hltas".to_string(),
+        value: path.display().to_string(),
+        allowed: format!(
+            "used with a GoldSrc scene (Bunnymod XT scripts replay Half-Life; {} is a {} scene)",
+            scene.name,
+            scene.preset.name()
+        ),
+    })
+}
+
+/// The scene file a result names (`"scene_path"`): the absolute path of the file loaded, so `report`
+/// can rebuild the runs from any directory; the origin as given when it cannot be resolved.
+pub fn scene_path(scene: &Scene) -> String {
+    std::fs::canonicalize(&scene.origin)
+        .map(|p| p.display().to_string())
+        .unwrap_or_else(|_| scene.origin.clone())
+}
+
 fn opt_finite(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
 }
 
-/// The `--json` object of a simulated run.
+/// The `--json` object of a simulated run. It carries what `strafeopt report` needs to rebuild the run:
+/// `scene_path` (see [`scene_path`]), `controller` and `lookahead` (see [`super::report_cmd`]).
 pub fn summary_json(
     scene: &Scene,
     trace: &Trace,
@@ -71,6 +112,7 @@ pub fn summary_json(
         .map(|c| (c.time - bound.crossing.time) / bound.crossing.time.max(f64::MIN_POSITIVE));
     json!({
         "scenario": scene.name,
+        "scene_path": scene_path(scene),
         "controller": trace.controller,
         "lookahead": lookahead,
         "frames": frames,

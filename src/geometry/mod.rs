@@ -19,11 +19,13 @@ pub mod corridor;
 pub mod finish;
 mod grown;
 pub mod path;
+pub mod separate;
 pub mod sweep;
 pub mod wall;
 
 pub use corridor::{Corridor, Nearest};
 pub use finish::{FinishLine, FinishPoint};
+pub use separate::{HalfPlane, Separation};
 pub use sweep::{Cast, Contact, SweepResult, SweepStatus};
 pub use wall::{BoundaryKind, Wall, WallDefect};
 
@@ -44,6 +46,9 @@ pub const MIN_SEGMENT_LENGTH_UNITS: f64 = 1e-9;
 pub const MAX_BUMPS_PER_FRAME: usize = 4;
 
 /// How much the grown walls are shrunk for [`Corridor::shortest_path`], units, so that a path that touches
-/// a grown wall (as every shortest path does at its corners) is never blocked by rounding. Shrinking keeps
-/// the result a lower bound: it can only shorten the path, by at most a few times this value.
-pub const PATH_SHRINK_UNITS: f64 = 1e-7;
+/// a grown wall (as every shortest path does at its corners) is never blocked by rounding (about 1e-12
+/// units at corridor scale). Shrinking keeps the result a lower bound: it can only shorten the path, by at
+/// most a few times this value. It is exactly the contact tolerance, so the path search admits the same
+/// hull positions as the simulation and the scene validator (touching, or at most [`CONTACT_TOL_UNITS`]
+/// deep): a larger value let "a path exists" squeeze through gaps too narrow for the hull (issue 9).
+pub const PATH_SHRINK_UNITS: f64 = CONTACT_TOL_UNITS;

@@ -1,5 +1,13 @@
-//! Optimisation over control sequences: the lower bound on the time ([`bound`]).
+//! Optimisation over control sequences: the lower bound on the time ([`bound`]) and the planning model of
+//! the minimal-time search ([`model`]).
 
 pub mod bound;
+pub mod model;
+pub mod qp;
+pub mod search;
+pub mod shaping;
 
 pub use bound::{lower_bound, LowerBound};
+pub use search::{
+    solve, solve_with_progress, Outcome, Progress, Quality, SearchSettings, SearchStatus,
+};

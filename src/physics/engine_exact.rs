@@ -50,6 +50,18 @@ pub fn quantise_yaw_rad(yaw_rad: f64) -> f64 {
     ((k + 1e-6) * step).to_radians()
 }
 
+/// The two yaws on anglemod steps either side of `yaw_rad` (equal when it is on a step), each surviving
+/// anglemod unchanged: a planner picks between them to steer the game's quantised view.
+pub fn anglemod_bracket(yaw_rad: f64) -> (f64, f64) {
+    let step = 360.0 / f64::from(ANGLEMOD_STEPS);
+    let k = yaw_rad.to_degrees() / step;
+    let (lo, hi) = (k.floor(), k.ceil());
+    (
+        ((lo + 1e-6) * step).to_radians(),
+        ((hi + 1e-6) * step).to_radians(),
+    )
+}
+
 /// An `f64` state rounded to the game's `f32`.
 pub fn to_engine_state(s: &PlayerState) -> PlayerState<f32> {
     PlayerState {
@@ -146,6 +158,24 @@ mod tests {
         assert_eq!(neg, 0.0);
         let neg = f64::from(anglemod_deg(-10.0));
         assert!((neg - 350.0).abs() < step, "{neg}");
+    }
+
+    #[test]
+    fn bracket_yaws_are_adjacent_steps_around_the_yaw() {
+        let step = (360.0f64 / 65536.0).to_radians();
+        for i in 0..500 {
+            let yaw = -3.0 + 0.0123 * i as f64;
+            let (lo, hi) = anglemod_bracket(yaw);
+            assert!(
+                lo <= yaw + 1e-9 * step && hi >= yaw - 1e-9 * step,
+                "{yaw}: {lo} {hi}"
+            );
+            assert!(hi - lo <= step * (1.0 + 1e-9));
+            for y in [lo, hi] {
+                let back = f64::from(anglemod_deg(y.to_degrees() as f32));
+                assert!((back - y.to_degrees().rem_euclid(360.0)).abs() < 1e-3 * step.to_degrees());
+            }
+        }
     }
 
     #[test]

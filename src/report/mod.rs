@@ -1,4 +1,16 @@
 //! Reports: writers over any `io::Write` (the command line opens the files). Nothing here computes physics.
+//!
+//! - trajectories as CSV or JSON ([`write_trajectory_csv`], [`write_trajectory_json`]);
+//! - [`html`]: the self-contained HTML report ([`ReportInput`], [`write_html`]) with the SVG figures of
+//!   [`figures`];
+//! - [`hltas`]: the plan as a Bunnymod XT script ([`write_hltas`]).
+
+pub mod figures;
+pub mod hltas;
+pub mod html;
+
+pub use self::hltas::{hltas_script, write_hltas};
+pub use html::{write_html, ReportInput, ReportRun};
 
 use crate::sim::{FrameRecord, Trace};
 use std::io::{self, Write};

@@ -2,7 +2,10 @@
 //! one-sided strafers, and playback of a planned sequence.
 
 use super::{Controller, Simulation, Trace};
-use crate::physics::strafe::{max_accel_control, strafe_keys};
+use crate::physics::strafe::{
+    max_accel, max_accel_control, speed_preserving_cos_theta, strafe_control, strafe_keys,
+    theta_from_cos,
+};
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2, Wish};
 
 /// The keys a controller holds for a scene: full sidemove, jump held when the scene jumps (autojump).
@@ -68,6 +71,7 @@ pub struct Greedy {
     cumulative: Vec<f64>,
     lookahead_units: f64,
     last_side: Side,
+    speed_cap_ups: Option<f64>,
 }
 
 impl Greedy {
@@ -86,7 +90,16 @@ impl Greedy {
             cumulative,
             lookahead_units,
             last_side: Side::Right,
+            speed_cap_ups: None,
         }
+    }
+
+    /// The same strafer holding its speed at `cap_ups` once reached: above it, it strafes at the
+    /// speed-preserving angle (physics.md section 8), which turns harder than maximum acceleration. With
+    /// the cap from the radius-speed relation (section 9) it takes corners the greedy speed cannot.
+    pub fn with_speed_cap(mut self, cap_ups: f64) -> Self {
+        self.speed_cap_ups = Some(cap_ups);
+        self
     }
 
     /// The look-ahead distance, units.
@@ -138,7 +151,10 @@ impl Greedy {
 
 impl Controller for Greedy {
     fn name(&self) -> String {
-        "greedy".to_string()
+        match self.speed_cap_ups {
+            None => "greedy".to_string(),
+            Some(cap) => format!("greedy-capped-{cap:.0}"),
+        }
     }
 
     fn control(&mut self, _frame: u64, s: &PlayerState, sim: &Simulation) -> Control {
@@ -161,7 +177,23 @@ impl Controller for Greedy {
             Side::Right
         };
         self.last_side = side;
-        max_accel_control(sim.stepper(), s, scene_keys(sim), side, to_target.angle())
+        match self.speed_cap_ups {
+            Some(cap) if s.speed() >= cap => {
+                let before = s.speed();
+                strafe_control(
+                    sim.stepper(),
+                    s,
+                    scene_keys(sim),
+                    to_target.angle(),
+                    |lambda, law| {
+                        let cos = speed_preserving_cos_theta(before.min(cap), lambda, law)
+                            .unwrap_or_else(|| max_accel(lambda, law).cos_theta);
+                        side.sign() * theta_from_cos(cos)
+                    },
+                )
+            }
+            _ => max_accel_control(sim.stepper(), s, scene_keys(sim), side, to_target.angle()),
+        }
     }
 }
 
@@ -214,4 +246,27 @@ fn rank(t: &Trace, guide: &Greedy) -> (u8, f64) {
             (2, -guide.project(end))
         }
     }
+}
+
+/// The best run over look-aheads and speed caps (the caps seed corner lines for the optimiser), ranked as
+/// in [`best_greedy`]. Returns the trace, the look-ahead and the cap.
+pub fn best_capped_greedy(
+    sim: &Simulation,
+    path: &[Vec2],
+    lookaheads: &[f64],
+    caps_ups: &[f64],
+) -> (Trace, f64, Option<f64>) {
+    let guide = Greedy::new(path.to_vec(), 0.0);
+    let (t, la) = best_greedy(sim, path, lookaheads);
+    let mut best = (rank(&t, &guide), t, la, None);
+    for &cap in caps_ups {
+        for &la in lookaheads {
+            let t = sim.run(&mut Greedy::new(path.to_vec(), la).with_speed_cap(cap));
+            let r = rank(&t, &guide);
+            if r < best.0 {
+                best = (r, t, la, Some(cap));
+            }
+        }
+    }
+    (best.1, best.2, best.3)
 }

@@ -1,0 +1,404 @@
+//! The frame in planning variables (issue 5; physics.md sections 5 and 6). A frame is described by its side
+//! `sigma` (wish direction left, +1, or right, -1, of the velocity) and `c = v . a_hat`, the velocity's
+//! projection on the wish direction; `mu` follows from `c` by the law `mu = min(gamma1, L - c)` (0 when
+//! `L <= c`). The state is the position, the speed `V` and the heading `psi`:
+//!
+//! ```text
+//! forward = V + mu c / V,   lateral = mu sqrt(V^2 - c^2) / V
+//! V'   = sqrt(forward^2 + lateral^2)         (= sqrt(V^2 + 2 mu c + mu^2), the scalar FME)
+//! psi' = psi + sigma atan2(lateral, forward)
+//! p'   = p + tau V' (cos psi', sin psi')
+//! ```
+//!
+//! For `sigma = +-1` this is the game's airborne frame exactly. Relaxing `sigma` to `[-1, 1]` is the limit
+//! of fast left/right alternation: the speed grows as in every frame, the heading turns by the fraction
+//! `sigma` of a full turn. Raw yaw is a badly conditioned variable (the speed gain changes with slope
+//! about `|v|` per radian near the best angle); `(sigma, c)` are not.
+
+use crate::physics::{AccelLaw, Control, Vec2};
+use std::ops::{Add, Div, Mul, Sub};
+
+/// The constants of one airborne frame: frame time and the acceleration law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameLaw {
+    /// Frame time `tau`, seconds.
+    pub tau_s: f64,
+    /// `L` and `gamma1`.
+    pub law: AccelLaw,
+    /// Sidemove held, ups (sets `M`; the yaw is turned by `atan2(S, F)`).
+    pub side_key_speed: f64,
+}
+
+impl FrameLaw {
+    /// The `c` of maximum acceleration at speed `v` (physics.md section 6): `min(L - gamma1, V)` in case 1,
+    /// 0 in case 2. Larger `c` gains less speed and turns less, so it is the upper bound of `c`.
+    pub fn c_max(&self, v: f64) -> f64 {
+        let AccelLaw { l, gamma1 } = self.law;
+        if gamma1 <= l {
+            (l - gamma1).min(v)
+        } else {
+            0.0
+        }
+    }
+
+    /// `L - gamma1`, where the law's two pieces meet.
+    pub fn kink(&self) -> f64 {
+        self.law.l - self.law.gamma1
+    }
+}
+
+/// The planning state after a frame: position (units), speed (ups), heading (radians).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelState {
+    /// Hull centre.
+    pub pos: Vec2,
+    /// Speed `V`.
+    pub speed: f64,
+    /// Heading `psi` of the velocity.
+    pub heading: f64,
+}
+
+impl ModelState {
+    /// The velocity vector.
+    pub fn velocity(&self) -> Vec2 {
+        Vec2::from_angle(self.heading) * self.speed
+    }
+}
+
+/// One frame's planning control.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameControl {
+    /// Side, `+1` left, `-1` right; relaxed values in between.
+    pub sigma: f64,
+    /// `c = v . a_hat`, ups.
+    pub c: f64,
+}
+
+/// Derivatives of one frame: `A = d x' / d x` and `B = d x' / d u` with `x = (px, py, V, psi)`,
+/// `u = (sigma, c)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameJacobian {
+    /// `d x' / d x`, row-major.
+    pub a: [[f64; 4]; 4],
+    /// `d x' / d u`, row-major.
+    pub b: [[f64; 2]; 4],
+}
+
+/// A number with its derivatives with respect to `(V, psi, c, sigma)`: forward-mode differentiation.
+#[derive(Clone, Copy, Debug)]
+struct Dual {
+    v: f64,
+    d: [f64; 4],
+}
+
+impl Dual {
+    fn constant(v: f64) -> Dual {
+        Dual { v, d: [0.0; 4] }
+    }
+    fn var(v: f64, i: usize) -> Dual {
+        let mut d = [0.0; 4];
+        d[i] = 1.0;
+        Dual { v, d }
+    }
+    fn map(self, v: f64, dv: f64) -> Dual {
+        Dual {
+            v,
+            d: self.d.map(|x| x * dv),
+        }
+    }
+    fn sqrt(self) -> Dual {
+        let r = self.v.sqrt();
+        self.map(r, if r > 0.0 { 0.5 / r } else { 0.0 })
+    }
+    fn sin(self) -> Dual {
+        self.map(self.v.sin(), self.v.cos())
+    }
+    fn cos(self) -> Dual {
+        self.map(self.v.cos(), -self.v.sin())
+    }
+    fn atan2(self, x: Dual) -> Dual {
+        // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2)
+        let r2 = self.v * self.v + x.v * x.v;
+        let mut d = [0.0; 4];
+        if r2 > 0.0 {
+            for (i, di) in d.iter_mut().enumerate() {
+                *di = (x.v * self.d[i] - self.v * x.d[i]) / r2;
+            }
+        }
+        Dual {
+            v: self.v.atan2(x.v),
+            d,
+        }
+    }
+}
+
+impl Add for Dual {
+    type Output = Dual;
+    fn add(self, o: Dual) -> Dual {
+        let mut d = self.d;
+        for (a, b) in d.iter_mut().zip(o.d) {
+            *a += b;
+        }
+        Dual { v: self.v + o.v, d }
+    }
+}
+
+impl Sub for Dual {
+    type Output = Dual;
+    fn sub(self, o: Dual) -> Dual {
+        let mut d = self.d;
+        for (a, b) in d.iter_mut().zip(o.d) {
+            *a -= b;
+        }
+        Dual { v: self.v - o.v, d }
+    }
+}
+
+impl Mul for Dual {
+    type Output = Dual;
+    fn mul(self, o: Dual) -> Dual {
+        let mut d = [0.0; 4];
+        for (i, di) in d.iter_mut().enumerate() {
+            *di = self.d[i] * o.v + self.v * o.d[i];
+        }
+        Dual { v: self.v * o.v, d }
+    }
+}
+
+impl Div for Dual {
+    type Output = Dual;
+    fn div(self, o: Dual) -> Dual {
+        let mut d = [0.0; 4];
+        for (i, di) in d.iter_mut().enumerate() {
+            *di = (self.d[i] * o.v - self.v * o.d[i]) / (o.v * o.v);
+        }
+        Dual { v: self.v / o.v, d }
+    }
+}
+
+/// Smallest `V^2 - c^2` used under the square root (keeps `sin theta` real at `c = V`).
+const MIN_SIN_SQ_UPS2: f64 = 1e-18;
+
+/// One frame in planning variables, with its Jacobian when `jacobian` is set.
+pub fn frame(
+    x: &ModelState,
+    u: FrameControl,
+    fl: &FrameLaw,
+    jacobian: bool,
+) -> (ModelState, Option<FrameJacobian>) {
+    let v = Dual::var(x.speed, 0);
+    let psi = Dual::var(x.heading, 1);
+    let c = Dual::var(u.c, 2);
+    let sigma = Dual::var(u.sigma, 3);
+    let AccelLaw { l, gamma1 } = fl.law;
+    // mu = min(gamma1, L - c) when L - c > 0, else 0 (physics.md section 5); the piece is fixed by value.
+    let gamma2 = Dual::constant(l) - c;
+    let mu = if gamma2.v <= 0.0 {
+        Dual::constant(0.0)
+    } else if gamma1 <= gamma2.v {
+        Dual::constant(gamma1)
+    } else {
+        gamma2
+    };
+    let sin_sq = v * v - c * c;
+    let sin_sq = if sin_sq.v > MIN_SIN_SQ_UPS2 {
+        sin_sq
+    } else {
+        Dual::constant(MIN_SIN_SQ_UPS2)
+    };
+    let forward = v + mu * c / v;
+    let lateral = mu * sin_sq.sqrt() / v;
+    let v_new = (forward * forward + lateral * lateral).sqrt();
+    let psi_new = psi + sigma * lateral.atan2(forward);
+    let tau = Dual::constant(fl.tau_s);
+    let dx = tau * v_new * psi_new.cos();
+    let dy = tau * v_new * psi_new.sin();
+    let next = ModelState {
+        pos: Vec2::new(x.pos.x + dx.v, x.pos.y + dy.v),
+        speed: v_new.v,
+        heading: psi_new.v,
+    };
+    let jac = jacobian.then(|| {
+        let rows = [dx, dy, v_new, psi_new];
+        let mut a = [[0.0; 4]; 4];
+        let mut b = [[0.0; 2]; 4];
+        for (r, out) in rows.iter().enumerate() {
+            a[r][2] = out.d[0];
+            a[r][3] = out.d[1];
+            b[r][0] = out.d[3];
+            b[r][1] = out.d[2];
+        }
+        a[0][0] = 1.0;
+        a[1][1] = 1.0;
+        FrameJacobian { a, b }
+    });
+    (next, jac)
+}
+
+/// The states after each frame of `controls` from `start` (the start itself not included).
+pub fn rollout(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw) -> Vec<ModelState> {
+    let mut out = Vec::with_capacity(controls.len());
+    let mut x = *start;
+    for &u in controls {
+        x = frame(&x, u, fl, false).0;
+        out.push(x);
+    }
+    out
+}
+
+/// The game control that realises `(sigma = +-1, c)` from a velocity `vel`: the strafe angle
+/// `theta = sigma acos(c / |v|)` with full sidemove (physics.md section 5).
+pub fn control_for(vel: Vec2, u: FrameControl, fl: &FrameLaw) -> Control {
+    let speed = vel.length();
+    let cos_theta = if speed > 0.0 {
+        (u.c / speed).clamp(-1.0, 1.0)
+    } else {
+        1.0
+    };
+    let theta = u.sigma.signum() * cos_theta.acos();
+    Control::strafe(vel, vel.angle(), theta, 0.0, fl.side_key_speed)
+}
+
+/// The planning control of a game control played from velocity `vel`.
+pub fn frame_control_of(vel: Vec2, c: &Control) -> FrameControl {
+    let theta = c.theta_rad(vel);
+    FrameControl {
+        sigma: if theta >= 0.0 { 1.0 } else { -1.0 },
+        c: vel.length() * theta.cos(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::{curvature::air_law, Effects, MovementVars, PlayerState, Stepper};
+
+    fn law(fps: f64) -> (MovementVars, FrameLaw) {
+        let vars = MovementVars::goldsrc(fps);
+        (
+            vars,
+            FrameLaw {
+                tau_s: vars.frame_time_s(),
+                law: air_law(&vars),
+                side_key_speed: vars.side_key_speed,
+            },
+        )
+    }
+
+    #[test]
+    fn exact_sides_reproduce_the_game_frame() {
+        for fps in [100.0, 1000.0] {
+            let (vars, fl) = law(fps);
+            let st: Stepper<f64> = Stepper::new(&vars, Effects::AIR_ONLY);
+            let mut s = PlayerState::airborne(Vec2::ZERO, Vec2::new(300.0, 200.0));
+            let mut x = ModelState {
+                pos: s.pos,
+                speed: s.speed(),
+                heading: s.vel.angle(),
+            };
+            for k in 0..500 {
+                let u = FrameControl {
+                    sigma: if k % 3 == 0 { -1.0 } else { 1.0 },
+                    c: fl.c_max(x.speed) - (k % 7) as f64,
+                };
+                let c = control_for(s.vel, u, &fl);
+                st.step(&mut s, &c.wish());
+                x = frame(&x, u, &fl, false).0;
+                assert!((x.pos - s.pos).length() < 1e-6, "{fps} frame {k}");
+                assert!((x.speed - s.speed()).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let (_, fl) = law(100.0);
+        let x = ModelState {
+            pos: Vec2::new(3.0, 4.0),
+            speed: 612.0,
+            heading: 0.7,
+        };
+        for u in [
+            FrameControl {
+                sigma: 0.3,
+                c: -1.0,
+            }, // mu = L - c piece
+            FrameControl {
+                sigma: -1.0,
+                c: -40.0,
+            }, // mu = gamma1 piece
+        ] {
+            let (_, j) = frame(&x, u, &fl, true);
+            let j = j.unwrap_or(FrameJacobian {
+                a: [[f64::NAN; 4]; 4],
+                b: [[f64::NAN; 2]; 4],
+            });
+            let f = |x: &ModelState, u: FrameControl| {
+                let n = frame(x, u, &fl, false).0;
+                [n.pos.x, n.pos.y, n.speed, n.heading]
+            };
+            let h = 1e-6;
+            let fd = |plus: [f64; 4], minus: [f64; 4]| -> [f64; 4] {
+                std::array::from_fn(|i| (plus[i] - minus[i]) / (2.0 * h))
+            };
+            let dv = fd(
+                f(
+                    &ModelState {
+                        speed: x.speed + h,
+                        ..x
+                    },
+                    u,
+                ),
+                f(
+                    &ModelState {
+                        speed: x.speed - h,
+                        ..x
+                    },
+                    u,
+                ),
+            );
+            let dpsi = fd(
+                f(
+                    &ModelState {
+                        heading: x.heading + h,
+                        ..x
+                    },
+                    u,
+                ),
+                f(
+                    &ModelState {
+                        heading: x.heading - h,
+                        ..x
+                    },
+                    u,
+                ),
+            );
+            let dsig = fd(
+                f(
+                    &x,
+                    FrameControl {
+                        sigma: u.sigma + h,
+                        ..u
+                    },
+                ),
+                f(
+                    &x,
+                    FrameControl {
+                        sigma: u.sigma - h,
+                        ..u
+                    },
+                ),
+            );
+            let dc = fd(
+                f(&x, FrameControl { c: u.c + h, ..u }),
+                f(&x, FrameControl { c: u.c - h, ..u }),
+            );
+            for r in 0..4 {
+                assert!((j.a[r][2] - dv[r]).abs() < 1e-6, "dV row {r}");
+                assert!((j.a[r][3] - dpsi[r]).abs() < 1e-6, "dpsi row {r}");
+                assert!((j.b[r][0] - dsig[r]).abs() < 1e-6, "dsigma row {r}");
+                assert!((j.b[r][1] - dc[r]).abs() < 1e-6, "dc row {r}");
+            }
+        }
+    }
+}

@@ -1,0 +1,264 @@
+//! The convexified sub-step (issue 5): the dynamics linearised around the current trajectory, the walls as
+//! separating half-planes, a trust region, and slack so that every sub-problem is feasible. Solved by
+//! Clarabel as `min 0.5 z'Pz + q'z  s.t.  Az + s = b, s in K`.
+//!
+//! Variables, in order: per frame `k` the control change `(d sigma_k, d c_k / C_SCALE)`; per frame the
+//! state change `dx_k = (d px, d py, d V, d psi)` after frame `k`; one slack per wall row. Rows: the
+//! linearised dynamics (zero cone, one block per frame: `dx_k - A_k dx_{k-1} - B_k du_k = 0`), then
+//! inequalities (nonnegative cone): wall rows `-n . dp_k - s_j <= n . p_k - offset - margin`, slack signs,
+//! and the trust-region and bound rows on the controls.
+
+use super::model::FrameJacobian;
+use crate::geometry::HalfPlane;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, NonnegativeConeT,
+    SolverStatus, SupportedConeT, ZeroConeT,
+};
+
+/// `c` enters the sub-problem divided by this (ups), so both controls have unit scale.
+pub const C_SCALE_UPS: f64 = 10.0;
+/// Weight of the control changes in the objective (keeps the sub-problem strictly convex in them).
+pub const CONTROL_REGULARISATION: f64 = 1e-6;
+
+/// A wall row: the position after frame `frame` (0-based) must stay on the free side of `plane` by
+/// `margin` units.
+#[derive(Clone, Copy, Debug)]
+pub struct WallRow {
+    /// 0-based frame whose end position is constrained.
+    pub frame: usize,
+    /// The half-plane.
+    pub plane: HalfPlane,
+}
+
+/// Everything the sub-problem needs about the current trajectory.
+pub struct SubProblem<'a> {
+    /// Per frame, the Jacobian of the frame at the current trajectory.
+    pub jacobians: &'a [FrameJacobian],
+    /// Per frame, the current end position.
+    pub positions: &'a [crate::physics::Vec2],
+    /// Wall rows.
+    pub walls: &'a [WallRow],
+    /// Wall margin, units: the clearance the sub-problem asks for.
+    pub margin: f64,
+    /// The clearance the merit accepts, units (at most `margin`): the predicted gain counts violations
+    /// below this, as the merit does.
+    pub accepted_clearance: f64,
+    /// Weight of a unit of slack (wall violation) against a unit of progress.
+    pub slack_weight: f64,
+    /// Unit normal of the finish line: progress is `n . p_N`.
+    pub progress_dir: crate::physics::Vec2,
+    /// Per frame, the allowed change of sigma: `[-lo, hi]`.
+    pub sigma_range: &'a [(f64, f64)],
+    /// Per frame, the allowed change of c, ups: `[-lo, hi]`.
+    pub c_range: &'a [(f64, f64)],
+}
+
+/// How a sub-problem ended, mapped from Clarabel's status in one place.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SubStepStatus {
+    /// Solved (possibly to reduced accuracy): the step is usable.
+    Solved {
+        /// Reduced accuracy (`AlmostSolved`).
+        almost: bool,
+    },
+    /// Clarabel stopped without a usable step (infeasible certificate, iteration or time limit, numerical
+    /// error, insufficient progress): shrink the trust region and try again.
+    Failed(String),
+}
+
+/// The result of one sub-problem.
+#[derive(Clone, Debug)]
+pub struct SubStep {
+    /// What happened.
+    pub status: SubStepStatus,
+    /// Per frame `(d sigma, d c)` (c in ups), when solved.
+    pub du: Vec<(f64, f64)>,
+    /// The model's predicted decrease of the merit (progress minus weighted violation), when solved.
+    pub predicted: f64,
+}
+
+/// Solves the sub-problem. Dimension errors from Clarabel (which would be a bug here) come back as a
+/// failed status, never a panic.
+pub fn solve(sp: &SubProblem) -> SubStep {
+    let n = sp.jacobians.len();
+    let m_w = sp.walls.len();
+    let nu = 2 * n;
+    let nx = 4 * n;
+    let nvar = nu + nx + m_w;
+    let iu = |k: usize, j: usize| 2 * k + j;
+    let ix = |k: usize, i: usize| nu + 4 * k + i;
+    let is = |j: usize| nu + nx + j;
+
+    let (mut ri, mut ci, mut vals): (Vec<usize>, Vec<usize>, Vec<f64>) = (vec![], vec![], vec![]);
+    let mut b: Vec<f64> = Vec::new();
+    let mut row = 0usize;
+    // Dynamics: dx_k - A_k dx_{k-1} - B_k du_k = 0.
+    for (k, jac) in sp.jacobians.iter().enumerate() {
+        for i in 0..4 {
+            ri.push(row);
+            ci.push(ix(k, i));
+            vals.push(1.0);
+            if k > 0 {
+                for (j, &a) in jac.a[i].iter().enumerate() {
+                    if a != 0.0 {
+                        ri.push(row);
+                        ci.push(ix(k - 1, j));
+                        vals.push(-a);
+                    }
+                }
+            }
+            for (j, &bb) in jac.b[i].iter().enumerate() {
+                let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
+                if bb != 0.0 {
+                    ri.push(row);
+                    ci.push(iu(k, j));
+                    vals.push(-bb * scale);
+                }
+            }
+            b.push(0.0);
+            row += 1;
+        }
+    }
+    let n_eq = row;
+    // Walls: -n . dp_k - s_j <= n . p_k - offset - margin.
+    let mut slack0 = 0.0;
+    for (j, w) in sp.walls.iter().enumerate() {
+        let p = sp.positions[w.frame];
+        ri.extend([row, row, row]);
+        ci.extend([ix(w.frame, 0), ix(w.frame, 1), is(j)]);
+        vals.extend([-w.plane.normal.x, -w.plane.normal.y, -1.0]);
+        let rhs = w.plane.side(p) - sp.margin;
+        slack0 += (-rhs).max(0.0);
+        b.push(rhs);
+        row += 1;
+    }
+    // Slacks are nonnegative.
+    for j in 0..m_w {
+        ri.push(row);
+        ci.push(is(j));
+        vals.push(-1.0);
+        b.push(0.0);
+        row += 1;
+    }
+    // Trust region and bounds on the controls.
+    for k in 0..n {
+        let (slo, shi) = sp.sigma_range[k];
+        let (clo, chi) = sp.c_range[k];
+        for (var, lo, hi) in [
+            (iu(k, 0), slo, shi),
+            (iu(k, 1), clo / C_SCALE_UPS, chi / C_SCALE_UPS),
+        ] {
+            ri.push(row);
+            ci.push(var);
+            vals.push(1.0);
+            b.push(hi.max(0.0));
+            row += 1;
+            ri.push(row);
+            ci.push(var);
+            vals.push(-1.0);
+            b.push(lo.max(0.0));
+            row += 1;
+        }
+    }
+    let n_ineq = row - n_eq;
+
+    let a = CscMatrix::new_from_triplets(row, nvar, ri, ci, vals);
+    // P: regularisation of the control changes (upper triangle, diagonal only).
+    let p = CscMatrix::new_from_triplets(
+        nvar,
+        nvar,
+        (0..nu).collect(),
+        (0..nu).collect(),
+        vec![CONTROL_REGULARISATION; nu],
+    );
+    let mut q = vec![0.0; nvar];
+    if n > 0 {
+        q[ix(n - 1, 0)] = -sp.progress_dir.x;
+        q[ix(n - 1, 1)] = -sp.progress_dir.y;
+    }
+    for j in 0..m_w {
+        q[is(j)] = sp.slack_weight;
+    }
+    let cones: Vec<SupportedConeT<f64>> = vec![ZeroConeT(n_eq), NonnegativeConeT(n_ineq)];
+    let settings: DefaultSettings<f64> = match DefaultSettingsBuilder::default()
+        .verbose(false)
+        .presolve_enable(false)
+        .build()
+    {
+        Ok(s) => s,
+        Err(e) => {
+            return SubStep {
+                status: SubStepStatus::Failed(format!("settings: {e}")),
+                du: vec![],
+                predicted: 0.0,
+            }
+        }
+    };
+    let mut solver = match DefaultSolver::new(&p, &q, &a, &b, &cones, settings) {
+        Ok(s) => s,
+        Err(e) => {
+            return SubStep {
+                status: SubStepStatus::Failed(format!("setup: {e:?}")),
+                du: vec![],
+                predicted: 0.0,
+            }
+        }
+    };
+    solver.solve();
+    let status = match solver.solution.status {
+        SolverStatus::Solved => SubStepStatus::Solved { almost: false },
+        SolverStatus::AlmostSolved => SubStepStatus::Solved { almost: true },
+        other @ (SolverStatus::PrimalInfeasible
+        | SolverStatus::DualInfeasible
+        | SolverStatus::AlmostPrimalInfeasible
+        | SolverStatus::AlmostDualInfeasible
+        | SolverStatus::MaxIterations
+        | SolverStatus::MaxTime
+        | SolverStatus::NumericalError
+        | SolverStatus::InsufficientProgress
+        | SolverStatus::CallbackTerminated
+        | SolverStatus::Unsolved) => SubStepStatus::Failed(format!("{other:?}")),
+    };
+    let x = &solver.solution.x;
+    if !matches!(status, SubStepStatus::Solved { .. })
+        || x.len() != nvar
+        || x.iter().any(|v| !v.is_finite())
+    {
+        let status = match status {
+            SubStepStatus::Solved { .. } => SubStepStatus::Failed("non-finite solution".into()),
+            s => s,
+        };
+        return SubStep {
+            status,
+            du: vec![],
+            predicted: 0.0,
+        };
+    }
+    let du: Vec<(f64, f64)> = (0..n)
+        .map(|k| (x[iu(k, 0)], x[iu(k, 1)] * C_SCALE_UPS))
+        .collect();
+    let progress_gain = if n > 0 {
+        sp.progress_dir.x * x[ix(n - 1, 0)] + sp.progress_dir.y * x[ix(n - 1, 1)]
+    } else {
+        0.0
+    };
+    // The merit's violation, linearised: per wall row, how far below the accepted clearance it is before
+    // and after the step (the merit counts each frame's worst row; rows of one frame rarely differ much).
+    let mut viol_before = 0.0;
+    let mut viol_after = 0.0;
+    for w in sp.walls {
+        let p = sp.positions[w.frame];
+        let side = w.plane.side(p);
+        let dp = w.plane.normal.x * x[ix(w.frame, 0)] + w.plane.normal.y * x[ix(w.frame, 1)];
+        viol_before += (sp.accepted_clearance - side).max(0.0);
+        viol_after += (sp.accepted_clearance - side - dp).max(0.0);
+    }
+    let _ = slack0;
+    let predicted = progress_gain + sp.slack_weight * (viol_before - viol_after);
+    SubStep {
+        status,
+        du,
+        predicted,
+    }
+}

@@ -1,0 +1,113 @@
+//! `strafeopt solve` through the real binary.
+
+use assert_cmd::Command;
+use serde_json::Value;
+use std::process::Output;
+
+fn strafeopt(args: &[&str]) -> Output {
+    Command::cargo_bin("strafeopt")
+        .map(|mut c| {
+            c.current_dir(env!("CARGO_MANIFEST_DIR"))
+                .args(args)
+                .output()
+        })
+        .unwrap_or_else(|e| panic!("binary: {e}"))
+        .unwrap_or_else(|e| panic!("run {args:?}: {e}"))
+}
+
+#[test]
+fn json_carries_every_documented_key() {
+    let out = strafeopt(&[
+        "solve",
+        "scenarios/hl-bend90-100fps.toml",
+        "--quality",
+        "fast",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.stderr.is_empty(), "no progress output with --json");
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}"));
+    for key in [
+        "scenario",
+        "quality",
+        "frames",
+        "time",
+        "feasible",
+        "min_clearance",
+        "engine_exact",
+        "greedy",
+        "lower_bound",
+        "solve_seconds",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    for (obj, keys) in [
+        ("engine_exact", &["frames", "time", "feasible"][..]),
+        ("greedy", &["frames", "time", "feasible"][..]),
+        ("lower_bound", &["frames", "time"][..]),
+    ] {
+        for k in keys {
+            assert!(v[obj].get(k).is_some(), "missing {obj}.{k}");
+        }
+    }
+    assert_eq!(v["quality"], "fast");
+    assert_eq!(v["feasible"], true);
+    assert_eq!(v["engine_exact"]["feasible"], true);
+    let (t, g, lb) = (
+        v["time"].as_f64().unwrap_or(f64::NAN),
+        v["greedy"]["time"].as_f64().unwrap_or(f64::NAN),
+        v["lower_bound"]["time"].as_f64().unwrap_or(f64::NAN),
+    );
+    assert!(lb <= t && t < g, "{lb} <= {t} < {g}");
+    assert!(v["frames"].as_u64().unwrap_or(0) < v["greedy"]["frames"].as_u64().unwrap_or(0));
+}
+
+#[test]
+fn no_valid_path_is_exit_3_and_writes_nothing() {
+    // The bend with a frame cap too short for even the lower bound to reach the line.
+    let dir = std::env::temp_dir().join(format!("strafeopt-nopath-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{e}"));
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/hl-bend90-100fps.toml"),
+    )
+    .unwrap_or_default();
+    let scene = dir.join("short.toml");
+    std::fs::write(&scene, format!("max-frames = 100\n{text}")).unwrap_or_else(|e| panic!("{e}"));
+    let traj = dir.join("plan.csv");
+    let out = strafeopt(&[
+        "solve",
+        &scene.to_string_lossy(),
+        "--trajectory",
+        &traj.to_string_lossy(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("no valid path"), "{err}");
+    assert!(!traj.exists(), "a plan was written");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_time_limit_is_exit_2() {
+    for bad in ["0", "-1", "nan"] {
+        let out = strafeopt(&[
+            "solve",
+            "scenarios/hl-bend90-100fps.toml",
+            "--time-limit",
+            bad,
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--time-limit"));
+    }
+}
