@@ -91,10 +91,7 @@ fn scenes_beyond_airstrafing_return_the_greedy_run() {
     );
     assert_eq!(o.source, "greedy");
     assert!(o.trace.feasible());
-    // Quantising the greedy yaws changes the time by a hair at most.
-    let (t, g) = (
-        o.trace.crossing.map_or(f64::NAN, |c| c.time),
-        o.greedy.crossing.map_or(f64::NAN, |c| c.time),
-    );
-    assert!((t - g).abs() < 0.02, "{t} vs {g}");
+    // The greedy run itself is the plan: never worse than greedy.
+    assert_eq!(o.trace.crossing, o.greedy.crossing);
+    assert_eq!(o.controls, o.greedy.controls);
 }

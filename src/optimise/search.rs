@@ -27,7 +27,7 @@ use crate::physics::engine_exact::{anglemod_bracket, quantise_yaw_rad};
 use crate::physics::{Control, PlayerState, Vec2};
 use crate::scene::Scene;
 use crate::sim::controllers::{best_capped_greedy, GREEDY_LOOKAHEADS_UNITS};
-use crate::sim::{Controller, EngineRun, Playback, Simulation, Trace};
+use crate::sim::{Controller, EngineRun, Simulation, Trace};
 use argmin::core::{
     CostFunction, Error as ArgminError, Executor, IterState, Problem, Solver, State,
     TerminationReason, TerminationStatus, KV,
@@ -38,7 +38,7 @@ use std::time::{Duration, Instant};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Quality {
-    /// The relaxed problem with a coarse tolerance, rounded; no polishing.
+    /// The relaxed problem with a coarse tolerance, rounded, briefly polished.
     Fast,
     /// Relaxed, rounded, polished.
     Balanced,
@@ -87,7 +87,7 @@ impl SearchSettings {
             Quality::Fast => SearchSettings {
                 relaxed_iters: 25,
                 shaping_iters: 60,
-                polish_iters: 0,
+                polish_iters: 10,
                 tol_progress_units: 1e-3,
                 ..base
             },
@@ -517,9 +517,10 @@ fn run_scp(
                 .or(res.state().get_param())
                 .cloned()
                 .unwrap_or(x0);
+            // The solver's own counts (sub-problems, failures, rejections) with argmin's iterations.
             let stats = SearchStats {
                 iterations: res.state().get_iter(),
-                ..SearchStats::default()
+                ..res.solver.stats
             };
             (unpack(&best), timed_out, stats)
         }
@@ -731,22 +732,9 @@ pub fn solve_with_progress(
             source,
         }
     };
-    // The baseline plan: the plain greedy run, quantised.
-    let greedy_plan = {
-        let controls: Vec<Control> = greedy
-            .controls
-            .iter()
-            .map(|c| Control {
-                yaw_rad: quantise_yaw_rad(c.yaw_rad),
-                ..*c
-            })
-            .collect();
-        let trace = sim.run(&mut Playback {
-            controls: controls.clone(),
-            label: "greedy".into(),
-        });
-        (controls, trace)
-    };
+    // The baseline plan is the greedy run itself (its yaws as planned: the engine-exact replay applies
+    // anglemod, and quantising them here could cost the frame that makes the plan no worse than greedy).
+    let greedy_plan = (greedy.controls.clone(), greedy.clone());
     if !scene.effects.is_air_only() {
         return Ok(finish(
             greedy_plan.0,
