@@ -78,9 +78,17 @@ pub struct SubStep {
     pub predicted: f64,
 }
 
+/// Interior-point iterations Clarabel may take on one sub-problem.
+pub const MAX_SUBPROBLEM_ITERATIONS: u32 = 200;
+
 /// Solves the sub-problem. Dimension errors from Clarabel (which would be a bug here) come back as a
 /// failed status, never a panic.
 pub fn solve(sp: &SubProblem) -> SubStep {
+    solve_capped(sp, MAX_SUBPROBLEM_ITERATIONS)
+}
+
+/// [`solve`] with Clarabel's iteration cap given (tests force its `MaxIterations` status with it).
+pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
     let n = sp.jacobians.len();
     let m_w = sp.walls.len();
     let nu = 2 * n;
@@ -184,6 +192,7 @@ pub fn solve(sp: &SubProblem) -> SubStep {
     let settings: DefaultSettings<f64> = match DefaultSettingsBuilder::default()
         .verbose(false)
         .presolve_enable(false)
+        .max_iter(max_iterations)
         .build()
     {
         Ok(s) => s,
@@ -260,5 +269,110 @@ pub fn solve(sp: &SubProblem) -> SubStep {
         status,
         du,
         predicted,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::HalfPlane;
+    use crate::physics::Vec2;
+
+    /// One frame moving along +x; progress along +x; a wall row keeping the end position at y <= 0.
+    fn one_frame(
+        jac: FrameJacobian,
+        rhs_side: f64,
+    ) -> (Vec<FrameJacobian>, Vec<Vec2>, Vec<WallRow>) {
+        let walls = vec![WallRow {
+            frame: 0,
+            plane: HalfPlane {
+                normal: Vec2::new(0.0, -1.0),
+                offset: -rhs_side,
+            },
+        }];
+        (vec![jac], vec![Vec2::new(5.0, 0.0)], walls)
+    }
+
+    fn jacobian(v: f64) -> FrameJacobian {
+        let mut a = [[0.0; 4]; 4];
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] = 1.0;
+        }
+        // d px / d c = v, d py / d sigma = v
+        FrameJacobian {
+            a,
+            b: [[0.0, v], [v, 0.0], [0.0, 0.0], [0.0, 0.0]],
+        }
+    }
+
+    fn sub<'a>(
+        j: &'a [FrameJacobian],
+        p: &'a [Vec2],
+        w: &'a [WallRow],
+        ranges: &'a [(f64, f64)],
+    ) -> SubProblem<'a> {
+        SubProblem {
+            jacobians: j,
+            positions: p,
+            walls: w,
+            margin: 0.0,
+            accepted_clearance: 0.0,
+            slack_weight: 100.0,
+            progress_dir: Vec2::new(1.0, 0.0),
+            sigma_range: ranges,
+            c_range: ranges,
+        }
+    }
+
+    #[test]
+    fn a_plain_sub_step_moves_to_the_trust_region_edge_of_progress() {
+        let (j, p, w) = one_frame(jacobian(0.01), 10.0);
+        let ranges = [(1.0, 1.0)];
+        let r = solve(&sub(&j, &p, &w, &ranges));
+        assert_eq!(r.status, SubStepStatus::Solved { almost: false });
+        // Progress is 0.01 per ups of c: c rises to its bound, +1 ups.
+        assert!((r.du[0].1 - 1.0).abs() < 1e-6, "{:?}", r.du);
+        assert!((r.predicted - 0.01).abs() < 1e-6, "{}", r.predicted);
+    }
+
+    #[test]
+    fn clarabel_out_of_iterations_is_a_failed_step_not_a_panic() {
+        let (j, p, w) = one_frame(jacobian(0.01), 10.0);
+        let ranges = [(1.0, 1.0)];
+        let r = solve_capped(&sub(&j, &p, &w, &ranges), 1);
+        assert!(
+            matches!(r.status, SubStepStatus::Failed(ref s) if s.contains("MaxIterations")),
+            "{:?}",
+            r.status
+        );
+        assert!(r.du.is_empty());
+    }
+
+    #[test]
+    fn non_finite_data_is_a_failed_step_not_a_panic() {
+        let (j, p, w) = one_frame(jacobian(f64::NAN), 10.0);
+        let ranges = [(1.0, 1.0)];
+        let r = solve(&sub(&j, &p, &w, &ranges));
+        assert!(
+            matches!(r.status, SubStepStatus::Failed(_)),
+            "{:?}",
+            r.status
+        );
+    }
+
+    #[test]
+    fn an_unreachable_wall_is_paid_for_with_slack_not_infeasibility() {
+        // The end position must move 50 units but the trust region allows 1 ups of change: the sub-problem
+        // stays feasible through its slack and reports the violation it could not remove.
+        let (j, p, w) = one_frame(jacobian(0.01), -50.0);
+        let ranges = [(1.0, 1.0)];
+        let r = solve(&sub(&j, &p, &w, &ranges));
+        assert!(
+            matches!(r.status, SubStepStatus::Solved { .. }),
+            "{:?}",
+            r.status
+        );
+        // It uses the whole sideways range to reduce the violation: sigma moves y by -0.01.
+        assert!((r.du[0].0 + 1.0).abs() < 1e-6, "{:?}", r.du);
     }
 }

@@ -213,6 +213,46 @@ mod tests {
     use crate::physics::{curvature::air_law, MovementVars};
 
     #[test]
+    fn a_failing_line_search_keeps_the_start() {
+        // An infinite penalty makes every cost non-finite: argmin's run fails, and shaping hands back the
+        // controls it was given instead of panicking or returning garbage.
+        let vars = MovementVars::goldsrc(100.0);
+        let fl = FrameLaw {
+            tau_s: 0.01,
+            law: air_law(&vars),
+            side_key_speed: 400.0,
+        };
+        let walls = [Wall {
+            points: vec![Vec2::new(0.0, 1.0), Vec2::new(400.0, 1.0)],
+            closed: false,
+            kind: BoundaryKind::Rule,
+        }];
+        let corridor = Corridor::new(&walls).unwrap_or_else(|e| panic!("{e}"));
+        let pr = ShapingProblem {
+            start: ModelState {
+                pos: Vec2::ZERO,
+                speed: 400.0,
+                heading: 0.0,
+            },
+            fl,
+            corridor: &corridor,
+            finish_a: Vec2::new(300.0, 0.0),
+            progress_dir: Vec2::new(1.0, 0.0),
+            margin: f64::INFINITY,
+            penalty: 0.0,
+            wall_radius: 40.0,
+        };
+        let controls = vec![FrameControl { sigma: 0.5, c: 0.0 }; 20];
+        let (out, _) = shape(&pr, &controls, 50);
+        for (a, b) in out.iter().zip(&controls) {
+            assert!(
+                (a.sigma - b.sigma).abs() < 1e-12 && (a.c - b.c).abs() < 1e-9,
+                "{a:?} vs {b:?}"
+            );
+        }
+    }
+
+    #[test]
     fn gradient_matches_finite_differences() {
         let vars = MovementVars::goldsrc(100.0);
         let fl = FrameLaw {
