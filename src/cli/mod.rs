@@ -155,3 +155,44 @@ pub fn write_atomically(
     }
     result.map_err(io_err)
 }
+
+/// Writes the files a run asked for (`--trajectory`, `--report`, `--hltas`), each atomically: the trajectory
+/// and the TAS script of `plan`, and a report showing every run in `runs` (label, trace).
+pub fn write_artifacts(
+    artifacts: &args::ArtifactFlags,
+    scene: &crate::scene::Scene,
+    plan: &crate::sim::Trace,
+    runs: &[(&str, &crate::sim::Trace)],
+    bound: &crate::optimise::LowerBound,
+    summary: &serde_json::Value,
+) -> Result<(), Error> {
+    use crate::report;
+    if let Some(path) = &artifacts.trajectory {
+        let json = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        write_atomically(path, |w| {
+            if json {
+                report::write_trajectory_json(plan, w)
+            } else {
+                report::write_trajectory_csv(plan, w)
+            }
+        })?;
+    }
+    if let Some(path) = &artifacts.report {
+        let input = runs.iter().fold(
+            report::ReportInput::new(scene, bound, summary),
+            |input, (label, trace)| input.with_run(label, trace),
+        );
+        write_atomically(path, |w| report::write_html(&input, w))?;
+    }
+    if let Some(path) = &artifacts.hltas {
+        let script = report::hltas_script(plan, &scene.vars, &scene.name)?;
+        write_atomically(path, |w| {
+            script
+                .to_writer(w)
+                .map_err(|e| std::io::Error::other(format!("{e:?}")))
+        })?;
+    }
+    Ok(())
+}

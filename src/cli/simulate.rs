@@ -1,11 +1,10 @@
 //! `strafeopt simulate`: loads a scene, runs a controller, and prints its time beside the lower bound.
 
 use super::args::{ControllerArg, SimulateArgs};
-use super::write_atomically;
+use super::write_artifacts;
 use crate::error::{Error, Result};
 use crate::optimise::lower_bound;
 use crate::physics::{Game, Side};
-use crate::report::{self, ReportInput};
 use crate::scene::Scene;
 use crate::sim::controllers::{best_greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{Greedy, SideStrafer, Simulation, Trace};
@@ -35,31 +34,15 @@ pub fn run(args: &SimulateArgs) -> Result<String> {
         ControllerArg::MaxAccelLeft => (sim.run(&mut SideStrafer { side: Side::Left }), None),
         ControllerArg::MaxAccelRight => (sim.run(&mut SideStrafer { side: Side::Right }), None),
     };
-    if let Some(path) = &args.artifacts.trajectory {
-        let json = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-        write_atomically(path, |w| {
-            if json {
-                report::write_trajectory_json(&trace, w)
-            } else {
-                report::write_trajectory_csv(&trace, w)
-            }
-        })?;
-    }
     let summary = summary_json(&scene, &trace, &bound, lookahead);
-    if let Some(path) = &args.artifacts.report {
-        let input = ReportInput::new(&scene, &bound, &summary).with_run(&trace.controller, &trace);
-        write_atomically(path, |w| report::write_html(&input, w))?;
-    }
-    if let Some(path) = &args.artifacts.hltas {
-        let script = report::hltas_script(&trace, &scene.vars, &scene.name)?;
-        write_atomically(path, |w| {
-            script
-                .to_writer(w)
-                .map_err(|e| std::io::Error::other(format!("{e:?}")))
-        })?;
-    }
+    write_artifacts(
+        &args.artifacts,
+        &scene,
+        &trace,
+        &[(&trace.controller, &trace)],
+        &bound,
+        &summary,
+    )?;
     if args.output.json {
         Ok(format!("{summary}\n"))
     } else {

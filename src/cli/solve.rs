@@ -1,11 +1,10 @@
 //! `strafeopt solve`: the minimal-time plan of a scene, beside the greedy baseline and the lower bound.
 
 use super::args::{QualityArg, SolveArgs};
-use super::write_atomically;
+use super::write_artifacts;
 use crate::error::{Error, Result};
 use crate::optimise::search::{self, time_limit};
 use crate::optimise::{Outcome, Quality, SearchSettings};
-use crate::report::{self, ReportInput};
 use crate::scene::Scene;
 use serde_json::{json, Value};
 
@@ -64,33 +63,15 @@ pub fn run(args: &SolveArgs) -> Result<String> {
             scene.origin
         )));
     }
-    if let Some(path) = &args.artifacts.trajectory {
-        let json = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-        write_atomically(path, |w| {
-            if json {
-                report::write_trajectory_json(&outcome.trace, w)
-            } else {
-                report::write_trajectory_csv(&outcome.trace, w)
-            }
-        })?;
-    }
     let summary = summary_json(&scene, quality, &outcome);
-    if let Some(path) = &args.artifacts.report {
-        let input = ReportInput::new(&scene, &outcome.bound, &summary)
-            .with_run("greedy", &outcome.greedy)
-            .with_run("optimised", &outcome.trace);
-        write_atomically(path, |w| report::write_html(&input, w))?;
-    }
-    if let Some(path) = &args.artifacts.hltas {
-        let script = report::hltas_script(&outcome.trace, &scene.vars, &scene.name)?;
-        write_atomically(path, |w| {
-            script
-                .to_writer(w)
-                .map_err(|e| std::io::Error::other(format!("{e:?}")))
-        })?;
-    }
+    write_artifacts(
+        &args.artifacts,
+        &scene,
+        &outcome.trace,
+        &[("greedy", &outcome.greedy), ("optimised", &outcome.trace)],
+        &outcome.bound,
+        &summary,
+    )?;
     if args.output.json {
         Ok(format!("{summary}\n"))
     } else {

@@ -528,6 +528,28 @@ fn run_scp(
     }
 }
 
+/// One SCP stage: runs it, adds its work to `stats`, notes a timeout; returns the improved controls.
+fn scp_stage(
+    problem: ScpProblem,
+    controls: Vec<FrameControl>,
+    max_iters: u64,
+    settings: &SearchSettings,
+    deadline: Option<Instant>,
+    stats: &mut SearchStats,
+    timed_out: &mut bool,
+) -> Vec<FrameControl> {
+    let (c, t, s) = run_scp(
+        problem,
+        controls,
+        max_iters,
+        settings.tol_progress_units,
+        deadline,
+    );
+    add_stats(stats, s);
+    *timed_out |= t;
+    c
+}
+
 /// Sums the work counts.
 fn add_stats(a: &mut SearchStats, b: SearchStats) {
     a.iterations += b.iterations;
@@ -823,15 +845,15 @@ pub fn solve_with_progress(
             }
         }
         let pr = problem(relaxed_margin, true);
-        let (c, t, s) = run_scp(
+        let c = scp_stage(
             pr,
             controls.clone(),
             settings.relaxed_iters,
-            settings.tol_progress_units,
+            settings,
             deadline,
+            &mut stats,
+            &mut timed_out,
         );
-        add_stats(&mut stats, s);
-        timed_out |= t;
         let check = problem(relaxed_margin, true);
         let states = rollout(&start, &c, &fl);
         let reached = model_crossing(&start, &states, scene);
@@ -889,15 +911,15 @@ pub fn solve_with_progress(
         let mut exact = round_sides(&start, &relaxed, &fl);
         if settings.polish_iters > 0 && !timed_out {
             let pr = problem(settings.margin_units, false);
-            let (c, t, s) = run_scp(
+            let c = scp_stage(
                 pr,
                 exact.clone(),
                 settings.polish_iters,
-                settings.tol_progress_units,
+                settings,
                 deadline,
+                &mut stats,
+                &mut timed_out,
             );
-            add_stats(&mut stats, s);
-            timed_out |= t;
             exact = c;
         }
         let st = rollout(&start, &exact, &fl);
@@ -909,15 +931,15 @@ pub fn solve_with_progress(
         }
         margin *= MARGIN_GROWTH;
         let pr = problem(margin, true);
-        let (c, t, s) = run_scp(
+        let c = scp_stage(
             pr,
             relaxed.clone(),
             settings.relaxed_iters,
-            settings.tol_progress_units,
+            settings,
             deadline,
+            &mut stats,
+            &mut timed_out,
         );
-        add_stats(&mut stats, s);
-        timed_out |= t;
         let st = rollout(&start, &c, &fl);
         match model_crossing(&start, &st, scene) {
             Some(k) if problem(margin, true).violation(&st) <= 1e-9 => relaxed = c[..k].to_vec(),
