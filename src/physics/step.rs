@@ -407,17 +407,28 @@ impl<R: Real> Stepper<R> {
     #[inline]
     pub fn wish_direction(&self, w: &Wish<R>, ducked: bool, on_ground: bool) -> (V2<R>, R) {
         let (mut fm, mut sm) = (w.forwardmove, w.sidemove);
-        if ducked && self.effects.has(Effect::Duck) {
-            // GoldSrc's PM_Duck scales the keys whenever ducked; Source's HandleDuckingSpeedCrop only on
-            // the ground.
-            let applies = match self.game {
+        // The duck crop (0.333) and the clamp to the max speed come in each engine's own order: GoldSrc's
+        // PM_Duck scales the keys whenever ducked and PM_WalkMove/PM_AirMove clamp the wish speed after;
+        // Source's CheckParameters clamps the keys first and HandleDuckingSpeedCrop scales them after, on
+        // the ground only. Ducked walking is 450 * 0.333 = 149.85 ups of wish speed in Half-Life, but
+        // 150 * 0.333 = 49.95 in Half-Life 2 without the suit.
+        let crop = ducked
+            && self.effects.has(Effect::Duck)
+            && match self.game {
                 Game::GoldSrc => true,
                 Game::Source => on_ground,
             };
-            if applies {
-                fm = fm * self.duck_multiplier;
-                sm = sm * self.duck_multiplier;
+        if self.game == Game::Source {
+            let len = fm.hypot(sm);
+            if len > self.maxspeed {
+                let k = self.maxspeed / len;
+                fm = fm * k;
+                sm = sm * k;
             }
+        }
+        if crop {
+            fm = fm * self.duck_multiplier;
+            sm = sm * self.duck_multiplier;
         }
         let len = fm.hypot(sm);
         if len > R::ZERO {
@@ -691,6 +702,32 @@ mod tests {
         };
         st.pre_move(&mut s, &w);
         assert!((s.vel.x - 285.0).abs() < 1e-9, "{:?}", s.vel);
+    }
+
+    #[test]
+    fn duck_crop_and_max_speed_clamp_come_in_each_engines_order() {
+        let w = Wish {
+            forward: Vec2::new(1.0, 0.0),
+            forwardmove: 450.0,
+            ..Wish::default()
+        };
+        let fx = Effects::from_list(&[Effect::Duck, Effect::GroundAccel]);
+        // Source: clamp 450 to 150 first, then crop: 49.95.
+        let mut hl2 = MovementVars::source_hl2(200.0 / 3.0);
+        hl2.maxspeed = 150.0;
+        let st: Stepper<f64> = Stepper::new(&hl2, fx);
+        assert!((st.wish_direction(&w, true, true).1 - 150.0 * 0.333).abs() < 1e-9);
+        // Source in the air: no crop.
+        assert!((st.wish_direction(&w, true, false).1 - 150.0).abs() < 1e-9);
+        // GoldSrc: crop 400 first (133.2), then clamp to 320: 133.2.
+        let hl = MovementVars::goldsrc(100.0);
+        let st: Stepper<f64> = Stepper::new(&hl, fx);
+        let w1 = Wish {
+            forwardmove: 400.0,
+            ..w
+        };
+        assert!((st.wish_direction(&w1, true, true).1 - 400.0 * 0.333).abs() < 1e-9);
+        assert!((st.wish_direction(&w1, false, true).1 - 320.0).abs() < 1e-9);
     }
 
     #[test]
