@@ -5,6 +5,7 @@
 //! walls and finish line are geometry's types, so scene validation and simulation agree on contact.
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod cli;
 pub mod error;
 pub mod geometry;

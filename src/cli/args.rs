@@ -24,6 +24,8 @@ pub enum Command {
     Solve(SolveArgs),
     /// Turn a saved `--json` result into a self-contained HTML report.
     Report(ReportArgs),
+    /// Measure what accuracy costs in time: every level from the lower bound to the engine-exact plan.
+    Bench(super::bench::BenchArgs),
 }
 
 /// Output files every run can write besides `--trajectory`.
@@ -89,6 +91,9 @@ pub enum ControllerArg {
     MaxAccelLeft,
     /// Maximum acceleration turning right every frame.
     MaxAccelRight,
+    /// Accelerated backhopping (Source scenes; physics.md section 11): stand up, walk, a forward jump, then
+    /// ducked backhops facing backwards, steering on the jump frames to hold the lane.
+    Abh,
 }
 
 /// `strafeopt simulate SCENE ...`

@@ -12,6 +12,9 @@ use crate::physics::curvature::{
     speed_for_radius_source_text, HULL_WIDTH_UNITS,
 };
 use crate::physics::{abh, MovementVars, Preset, VarOverrides};
+use crate::scene::Scene;
+use crate::sim::abh::{run_abh, AbhParams};
+use crate::sim::Simulation;
 use serde_json::{json, Value};
 
 /// Most frames `frames-to-speed` steps before it trusts the closed form alone.
@@ -380,6 +383,8 @@ fn abh_table(
         "line at {distance} units crossed {crossing:.3} s after the first jump; the hop lands {:.2} units past it\n",
         a.landing_past_line
     ));
+    let frame_level = abh_frame_level(&vars, max_speed, distance)?;
+    text.push_str(&frame_level.text);
     Ok(Figures {
         json: json!({
             "form": "abh",
@@ -390,6 +395,105 @@ fn abh_table(
             "hop_time": hop_time,
             "distance": distance,
             "inputs": inputs(&vars, preset_name(engine, Preset::SourceHl2)),
+            "frame_level": frame_level.json,
+        }),
+        text,
+    })
+}
+
+/// The scene of the frame-level ABH run for `calc abh` (physics.md section 11): the resolved variables with
+/// max speed `max_speed`, every effect the run needs, a 64.04-unit rule lane (1.22 m) whose line is
+/// `distance` units from the start, a crouched start at rest. Written as a scene file and loaded, so it is
+/// validated like any other scene.
+fn abh_scene_toml(vars: &MovementVars, max_speed: f64, distance: f64) -> String {
+    format!(
+        "name = \"calc-abh\"\n\
+         [engine]\npreset = \"source-hl2\"\nfps = {:?}\nmaxspeed = {max_speed:?}\naccelerate = {:?}\n\
+         airaccelerate = {:?}\nfriction = {:?}\nentity-friction = {:?}\nstopspeed = {:?}\n\
+         maxvelocity = {:?}\ngravity = {:?}\n\
+         effects = [\"air-accel\", \"ground-accel\", \"friction\", \"gravity\", \"jump\", \"jump-boost\", \
+         \"duck\", \"max-velocity\", \"walls\"]\n\
+         [start]\nposition = [40.0, {:?}]\nvelocity = [0.0, 0.0]\non-ground = true\nducked = true\n\
+         [lane]\nwidth = {ABH_LANE_WIDTH_UNITS:?}\nlength = {:?}\nkind = \"rule\"\n",
+        vars.fps,
+        vars.accelerate,
+        vars.airaccelerate,
+        vars.friction,
+        vars.entity_friction,
+        vars.stopspeed,
+        vars.maxvelocity,
+        vars.gravity,
+        ABH_LANE_WIDTH_UNITS / 2.0,
+        40.0 + distance,
+    )
+}
+
+/// The lane width of the 100 m, units (1.22 m, physics.md section 1).
+const ABH_LANE_WIDTH_UNITS: f64 = 64.04;
+
+/// The frame-level ABH run (`sim::abh`) beside the article's model: hops, the time from the pistol to the
+/// first jump and to the line, and whether the run stayed in the lane (also engine-exact).
+fn abh_frame_level(vars: &MovementVars, max_speed: f64, distance: f64) -> Result<Figures> {
+    // A line closer than the default start's hull allows has no lane scene: the frame-level run is
+    // skipped (`null`) rather than the article's figures refused.
+    let scene = match Scene::from_toml_str(&abh_scene_toml(vars, max_speed, distance), "calc abh") {
+        Ok(scene) => scene,
+        Err(e) => {
+            return Ok(Figures {
+                json: Value::Null,
+                text: format!("frame-level run: skipped (no lane scene for these inputs: {e})\n"),
+            })
+        }
+    };
+    let sim = Simulation::new(&scene)?;
+    let run = run_abh(&sim, AbhParams::default());
+    let hops: Vec<Value> = run
+        .hops
+        .iter()
+        .map(
+            |h| json!({"time": h.time, "speed": h.speed, "frame": h.frame, "hop_time": h.hop_time}),
+        )
+        .collect();
+    let mut text = format!(
+        "frame-level run (tau = {:.4} s, gravity {}, 64.04-unit rule lane, crouched start at rest):\n\
+         \x20 hop   jump frame   time from pistol (s)   hop time (s)   speed (ups)\n",
+        vars.frame_time_s(),
+        vars.gravity
+    );
+    for (i, h) in run.hops.iter().enumerate() {
+        text.push_str(&format!(
+            "  {:>3}   {:>10}   {:>20.3}   {:>12}   {:>11.2}\n",
+            i + 1,
+            h.frame,
+            h.time,
+            h.hop_time.map_or("-".to_string(), |t| format!("{t:.3}")),
+            h.speed
+        ));
+    }
+    let fmt = |t: Option<f64>| t.map_or("none".to_string(), |t| format!("{t:.3} s"));
+    text.push_str(&format!(
+        "first jump: {}; line crossed from the pistol: {} ({} after the first jump); {}; engine-exact: {}\n",
+        fmt(run.first_jump),
+        fmt(run.pistol_to_line),
+        fmt(run.pistol_to_line.zip(run.first_jump).map(|(l, j)| l - j)),
+        if run.in_lane { "stayed in the lane" } else { "LEFT the lane" },
+        match (run.engine_exact.feasible(), run.engine_exact.crossing) {
+            (true, Some(c)) => format!("valid, line at {:.3} s", c.time),
+            (false, _) if run.engine_exact.broke_rule => "INVALID: left the lane".to_string(),
+            _ => "INVALID: did not reach the line".to_string(),
+        }
+    ));
+    Ok(Figures {
+        json: json!({
+            "hops": hops,
+            "pistol_to_line": run.pistol_to_line,
+            "first_jump": run.first_jump,
+            "in_lane": run.in_lane,
+            "engine_exact": {
+                "pistol_to_line": run.engine_exact.crossing.map(|c| c.time),
+                "in_lane": !run.engine_exact.broke_rule && run.engine_exact.finite,
+                "feasible": run.engine_exact.feasible(),
+            },
         }),
         text,
     })

@@ -3,6 +3,7 @@
 //! path through the scene, 1 anything else. Every error is one line on stderr behind `strafeopt: `.
 
 pub mod args;
+pub mod bench;
 pub mod calc;
 pub mod report_cmd;
 pub mod simulate;
@@ -119,6 +120,7 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
         Command::Simulate(a) => simulate::run(a),
         Command::Solve(a) => solve::run(a),
         Command::Report(a) => report_cmd::run(a),
+        Command::Bench(a) => bench::run(a),
         Command::Calc(c) => {
             let figures = calc::run(&c.form)?;
             if calc::wants_json(&c.form) {

@@ -33,6 +33,7 @@ pub fn run(args: &SimulateArgs) -> Result<String> {
         },
         ControllerArg::MaxAccelLeft => (sim.run(&mut SideStrafer { side: Side::Left }), None),
         ControllerArg::MaxAccelRight => (sim.run(&mut SideStrafer { side: Side::Right }), None),
+        ControllerArg::Abh => (sim.run(&mut crate::sim::abh::Abh::default()), None),
     };
     let summary = summary_json(&scene, &trace, &bound, lookahead);
     write_artifacts(

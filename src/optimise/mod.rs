@@ -2,10 +2,12 @@
 //! the minimal-time search ([`model`]).
 
 pub mod bound;
+pub mod hillclimb;
 pub mod model;
 pub mod qp;
 pub mod search;
 pub mod shaping;
+pub mod substep;
 
 pub use bound::{lower_bound, LowerBound};
 pub use search::{

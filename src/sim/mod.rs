@@ -6,6 +6,7 @@
 //! the solid walls (or moved freely), steps 5-6 follow, then rule lines are checked along the frame's
 //! straight move and the finish crossing is found with its fraction inside the frame.
 
+pub mod abh;
 pub mod controllers;
 pub mod trace;
 

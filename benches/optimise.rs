@@ -1,0 +1,86 @@
+//! What the optimiser's pieces cost (issue 8): the greedy strafer over 10,000 frames, the lower bound of a
+//! bend, one Clarabel sub-step, and a whole `solve --quality fast`. `strafeopt bench` measures accuracy
+//! against wall time on whole scenes; these are the speed targets.
+//!
+//! CI runs each once in test mode (`cargo test --release --benches`).
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use std::hint::black_box;
+use std::time::Duration;
+use strafeopt::optimise::substep::SubStepSetup;
+use strafeopt::optimise::{lower_bound, solve, Quality, SearchSettings};
+use strafeopt::physics::Vec2;
+use strafeopt::scene::Scene;
+use strafeopt::sim::{Greedy, Simulation};
+
+const BEND: &str = include_str!("../scenarios/hl-bend90-100fps.toml");
+
+/// A 1000 fps airborne lane too long to finish in the 10,000-frame cap: every run is 10,000 frames.
+const LANE: &str = r#"
+name = "bench-lane-1000fps"
+max-frames = 10000
+[engine]
+preset = "goldsrc"
+fps = 1000
+effects = ["air-accel", "max-velocity", "walls"]
+[lane]
+width = 256
+length = 20000
+kind = "rule"
+"#;
+
+fn scene(text: &str, origin: &str) -> Scene {
+    Scene::from_toml_str(text, origin).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn bench_strafer_and_bound(c: &mut Criterion) {
+    let lane = scene(LANE, "bench-lane");
+    let sim = Simulation::new(&lane).unwrap_or_else(|e| panic!("{e}"));
+    // The lane's centre line (its lower bound does not exist: the line is out of reach in the cap).
+    let y = lane.start.pos.y;
+    let path = vec![
+        lane.start.pos,
+        Vec2::new(lane.finish.a.x.max(lane.finish.b.x), y),
+    ];
+    let mut g = c.benchmark_group("strafer");
+    g.throughput(Throughput::Elements(lane.max_frames));
+    g.bench_function("greedy_10000_frames", |b| {
+        b.iter(|| {
+            let t = sim.run(&mut Greedy::new(black_box(path.clone()), 1000.0));
+            assert_eq!(t.frames.len(), 10_000);
+            black_box(t.final_speed())
+        })
+    });
+    g.finish();
+
+    let bend = scene(BEND, "hl-bend90-100fps.toml");
+    let corridor = bend.corridor().unwrap_or_else(|e| panic!("{e}"));
+    c.bench_function("lower_bound_bend90_100fps", |b| {
+        b.iter(|| black_box(lower_bound(black_box(&bend), &corridor).map(|l| l.crossing.time)))
+    });
+}
+
+fn bench_optimiser(c: &mut Criterion) {
+    let bend = scene(BEND, "hl-bend90-100fps.toml");
+    let fast = SearchSettings::for_quality(Quality::Fast);
+    let setup = SubStepSetup::greedy(&bend, &fast).unwrap_or_else(|e| panic!("{e}"));
+    let mut g = c.benchmark_group("optimiser");
+    g.sample_size(10).measurement_time(Duration::from_secs(5));
+    g.bench_function("clarabel_substep_bend90_100fps", |b| {
+        b.iter(|| black_box(setup.solve().predicted))
+    });
+    g.warm_up_time(Duration::from_millis(100));
+    g.bench_function("solve_fast_bend90_100fps", |b| {
+        b.iter(|| {
+            black_box(
+                solve(black_box(&bend), &fast)
+                    .map(|o| o.trace.crossing.map(|c| c.time))
+                    .unwrap_or_else(|e| panic!("{e}")),
+            )
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_strafer_and_bound, bench_optimiser);
+criterion_main!(benches);

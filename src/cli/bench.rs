@@ -1,0 +1,228 @@
+//! `strafeopt bench`: what accuracy costs in time (issue 8). Loads the scenes, runs
+//! [`crate::bench::measure_scene`] on each and [`crate::bench::measure_scaling`] on the first, and prints
+//! an aligned table or (`--json`) one array of rows; `--svg` writes gap against wall time.
+
+use super::args::QualityArg;
+use super::write_atomically;
+use crate::bench::{
+    measure_scaling, measure_scene, quality_name, write_accuracy_svg, BenchRow, BenchSettings,
+    Section,
+};
+use crate::error::{Error, Result};
+use crate::optimise::search::time_limit;
+use crate::optimise::Quality;
+use crate::scene::{Scene, SceneFile};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+/// The scenes measured when none are given: the four airborne scenes.
+pub const DEFAULT_SCENES: [&str; 4] = [
+    "scenarios/hl-bend90-100fps.toml",
+    "scenarios/hl-bend90-narrow-100fps.toml",
+    "scenarios/hl-hairpin-100fps.toml",
+    "scenarios/hl-bend90-1000fps-aa100.toml",
+];
+
+/// `strafeopt bench [SCENES...] ...`
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Scene files (default: the four airborne scenes in scenarios/).
+    pub scenes: Vec<PathBuf>,
+    /// Only the fast level, no frame-rate scaling; by default only the 100 fps scenes.
+    #[arg(long)]
+    pub quick: bool,
+    /// Solve qualities to measure, cheapest first (default: fast, balanced, exact; with --quick: fast).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub levels: Vec<QualityArg>,
+    /// Frame rate the first scene is also solved at, for the scaling rows.
+    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
+    pub scaling_fps: f64,
+    /// Leave out the frame-rate scaling rows.
+    #[arg(long)]
+    pub no_scaling: bool,
+    /// Leave out the hill-climbing baseline.
+    #[arg(long)]
+    pub no_hill_climb: bool,
+    /// Seed of the hill climber.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Stop each solve after this many seconds with its best valid plan.
+    #[arg(long, allow_negative_numbers = true)]
+    pub time_limit: Option<f64>,
+    /// Write gap against wall time as an SVG figure.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Print one JSON array of rows instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn quality(q: QualityArg) -> Quality {
+    match q {
+        QualityArg::Fast => Quality::Fast,
+        QualityArg::Balanced => Quality::Balanced,
+        QualityArg::Exact => Quality::Exact,
+    }
+}
+
+/// The width of a `[bend90]` shorthand, if the file has one.
+fn bend_width(path: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(path).ok()?;
+    SceneFile::from_toml_str(&text)
+        .ok()?
+        .bend90
+        .map(|b| b.width)
+}
+
+/// Runs `bench` and returns what to print.
+pub fn run(args: &BenchArgs) -> Result<String> {
+    let mut settings = BenchSettings {
+        hill_climb: !args.no_hill_climb,
+        ..BenchSettings::default()
+    };
+    if let Some(seed) = args.seed {
+        settings.seed = seed;
+    }
+    if !args.levels.is_empty() {
+        let mut levels: Vec<Quality> = args.levels.iter().map(|&q| quality(q)).collect();
+        levels.sort_by_key(|q| match q {
+            Quality::Fast => 0,
+            Quality::Balanced => 1,
+            Quality::Exact => 2,
+        });
+        levels.dedup();
+        settings.levels = levels;
+    } else if args.quick {
+        settings.levels = vec![Quality::Fast];
+    }
+    if let Some(s) = args.time_limit {
+        settings.time_limit = Some(time_limit(s)?);
+    }
+    if !(args.scaling_fps.is_finite() && args.scaling_fps > 0.0) {
+        return Err(Error::invalid(
+            "--scaling-fps",
+            args.scaling_fps,
+            "a finite number above 0",
+        ));
+    }
+    let paths: Vec<PathBuf> = if args.scenes.is_empty() {
+        DEFAULT_SCENES
+            .iter()
+            .filter(|p| !(args.quick && p.contains("1000fps")))
+            .map(PathBuf::from)
+            .collect()
+    } else {
+        args.scenes.clone()
+    };
+    // Every scene is loaded before anything is measured, so a bad file fails at once.
+    let scenes: Vec<(Scene, Option<f64>)> = paths
+        .iter()
+        .map(|p| Scene::load(p).map(|s| (s, bend_width(p))))
+        .collect::<Result<_>>()?;
+    let mut rows = Vec::new();
+    for (scene, width) in &scenes {
+        rows.extend(measure_scene(scene, *width, &settings)?);
+    }
+    if !(args.quick || args.no_scaling) {
+        if let Some((scene, _)) = scenes.first() {
+            if scene.vars.fps != args.scaling_fps {
+                let q = settings.levels.first().copied().unwrap_or(Quality::Fast);
+                rows.extend(measure_scaling(scene, args.scaling_fps, q, &settings)?);
+            }
+        }
+    }
+    if let Some(path) = &args.svg {
+        write_atomically(path, |w| write_accuracy_svg(&rows, w))?;
+    }
+    if args.json {
+        let text = serde_json::to_string(&rows)
+            .map_err(|e| Error::Io(format!("serialising the rows: {e}")))?;
+        Ok(format!("{text}\n"))
+    } else {
+        Ok(table(&rows))
+    }
+}
+
+fn opt<T>(v: Option<T>, f: impl Fn(T) -> String) -> String {
+    v.map_or_else(|| "-".to_string(), f)
+}
+
+/// The rows as an aligned text table (accuracy, then scaling).
+pub fn table(rows: &[BenchRow]) -> String {
+    let header = [
+        "scene", "fps", "method", "level", "wall (s)", "frames", "time (s)", "valid", "gap",
+        "iters", "evals", "notes",
+    ];
+    let mut cells: Vec<[String; 12]> = Vec::with_capacity(rows.len());
+    for r in rows {
+        let mut notes = r.status.clone().unwrap_or_default();
+        if let Some(v) = r.corner_speed_ups {
+            notes = format!("{notes}; corner speed {v:.1} ups");
+        }
+        if let (Some(w), Some(f)) = (r.wall_ratio, r.frames_ratio) {
+            notes = format!("{notes}; {w:.2}x wall time, {f:.2}x frames");
+        }
+        cells.push([
+            r.scene.clone(),
+            format!("{}", r.fps),
+            r.method.name().to_string(),
+            opt(r.quality, |q| quality_name(q).to_string()),
+            format!("{:.3}", r.wall_seconds),
+            opt(r.frames, |f| f.to_string()),
+            opt(r.time, |t| format!("{t:.6}")),
+            opt(r.feasible, |v| if v { "yes" } else { "no" }.to_string()),
+            opt(r.gap, |g| format!("{:+.3}%", 100.0 * g)),
+            opt(r.iterations, |i| i.to_string()),
+            opt(r.evaluations, |e| e.to_string()),
+            notes,
+        ]);
+    }
+    let mut widths = header.map(str::len);
+    for c in &cells {
+        for (w, s) in widths.iter_mut().zip(c) {
+            *w = (*w).max(s.chars().count());
+        }
+    }
+    // Text columns left-aligned, numbers right-aligned; the notes column is not padded.
+    let numeric = [
+        false, true, false, false, true, true, true, false, true, true, true, false,
+    ];
+    let line = |c: &[String]| {
+        let mut s = String::new();
+        for (i, v) in c.iter().enumerate() {
+            if i + 1 == c.len() {
+                s.push_str(v);
+            } else if numeric[i] {
+                s.push_str(&format!("{v:>w$}  ", w = widths[i]));
+            } else {
+                s.push_str(&format!("{v:<w$}  ", w = widths[i]));
+            }
+        }
+        s.trim_end().to_string() + "\n"
+    };
+    let mut out = String::new();
+    for (title, section) in [
+        ("accuracy against time", Section::Accuracy),
+        ("frame-rate scaling", Section::Scaling),
+    ] {
+        let part: Vec<&[String; 12]> = rows
+            .iter()
+            .zip(&cells)
+            .filter(|(r, _)| r.section == section)
+            .map(|(_, c)| c)
+            .collect();
+        if part.is_empty() {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push('\n');
+        }
+        out.push_str(title);
+        out.push('\n');
+        out.push_str(&line(&header.map(String::from)));
+        for c in part {
+            out.push_str(&line(c));
+        }
+    }
+    out
+}
