@@ -141,6 +141,7 @@ pub fn rebuild(result: &Value, origin: &str, base_dir: &Path) -> Result<Rebuilt>
                 })?;
             Some(sim.run(&mut Greedy::new(bound.path.clone(), la)))
         }
+        "abh" => Some(sim.run(&mut crate::sim::abh::Abh::default())),
         "max-accel-left" => Some(sim.run(&mut SideStrafer { side: Side::Left })),
         "max-accel-right" => Some(sim.run(&mut SideStrafer { side: Side::Right })),
         _ => None,
@@ -170,7 +171,7 @@ pub fn rebuild(result: &Value, origin: &str, base_dir: &Path) -> Result<Rebuilt>
             origin,
             "controller",
             format!(
-                "{controller:?}: must be greedy, max-accel-left or max-accel-right, or the result must carry \
+                "{controller:?}: must be greedy, abh, max-accel-left or max-accel-right, or the result must carry \
                  `plans`"
             ),
         ));

@@ -337,6 +337,9 @@ impl ScpSolver {
     }
 }
 
+/// Final wall margins tried, as multiples of the setting, until a plan stays valid.
+const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
+
 /// Times the relaxed plan is re-solved with a wider margin when rounding leaves the walls.
 const MARGIN_RETRIES: usize = 3;
 /// Factor by which that margin grows each time.
@@ -901,73 +904,83 @@ pub fn solve_with_progress(
         ));
     };
     progress(Progress::Finishing);
-    // Stage 2: exact sides, then c polished with the sides fixed. Where rounding leaves the walls (the
-    // relaxed plan ran closer than the rounded zigzag allows), the relaxed plan is re-solved at the same
-    // frame count with a wider margin, up to MARGIN_RETRIES times.
-    let mut candidates: Vec<Vec<FrameControl>> = Vec::new();
-    let mut relaxed = relaxed;
-    let mut margin = relaxed_margin;
-    for attempt in 0..=MARGIN_RETRIES {
-        let mut exact = round_sides(&start, &relaxed, &fl);
-        if settings.polish_iters > 0 && !timed_out {
-            let pr = problem(settings.margin_units, false);
-            let c = scp_stage(
-                pr,
-                exact.clone(),
-                settings.polish_iters,
-                settings,
-                deadline,
-                &mut stats,
-                &mut timed_out,
-            );
-            exact = c;
-        }
-        let st = rollout(&start, &exact, &fl);
-        let clean = problem(settings.margin_units, false).violation(&st) <= 1e-9;
-        let reaches = model_crossing(&start, &st, scene).is_some();
-        candidates.push(exact);
-        if (clean && reaches) || attempt == MARGIN_RETRIES || timed_out {
-            break;
-        }
-        margin *= MARGIN_GROWTH;
-        let pr = problem(margin, true);
-        let c = scp_stage(
-            pr,
-            relaxed.clone(),
-            settings.relaxed_iters,
-            settings,
-            deadline,
-            &mut stats,
-            &mut timed_out,
-        );
-        let st = rollout(&start, &c, &fl);
-        match model_crossing(&start, &st, scene) {
-            Some(k) if problem(margin, true).violation(&st) <= 1e-9 => relaxed = c[..k].to_vec(),
-            _ => {
-                // One frame more for the wider margin.
-                let mut longer = c;
-                let last = *longer.last().unwrap_or(&FrameControl {
-                    sigma: 0.0,
-                    c: fl.c_max(f64::INFINITY),
-                });
-                longer.push(last);
-                relaxed = longer;
-            }
-        }
-    }
-    // Stage 3: the real frame, quantised yaws, engine-exact check; keep the best valid plan.
+    // Stages 2 and 3, first with the settings' final margin; if no plan stays valid through rounding and
+    // quantisation (a tight margin along a long wall), again with wider ones.
+    let relaxed_plan = relaxed;
     let mut best = (
         time_of(&greedy_plan.1),
         greedy_plan.0,
         greedy_plan.1,
         "greedy",
     );
-    for cand in candidates {
-        let trace = sim.run(&mut PlanPlayer::new(&start, cand, fl, true));
-        let t = time_of(&trace);
-        let controls = trace.controls.clone();
-        if t < best.0 && sim.run_engine_exact(&controls).feasible() {
-            best = (t, controls, trace, "optimised");
+    for final_margin in FINAL_MARGIN_FACTORS.map(|f| f * settings.margin_units) {
+        // Stage 2: exact sides, then c polished with the sides fixed. Where rounding leaves the walls (the
+        // relaxed plan ran closer than the rounded zigzag allows), the relaxed plan is re-solved at the same
+        // frame count with a wider margin, up to MARGIN_RETRIES times.
+        let mut candidates: Vec<Vec<FrameControl>> = Vec::new();
+        let mut relaxed = relaxed_plan.clone();
+        let mut margin = relaxed_margin;
+        for attempt in 0..=MARGIN_RETRIES {
+            let mut exact = round_sides(&start, &relaxed, &fl);
+            if settings.polish_iters > 0 && !timed_out {
+                let pr = problem(final_margin, false);
+                let c = scp_stage(
+                    pr,
+                    exact.clone(),
+                    settings.polish_iters,
+                    settings,
+                    deadline,
+                    &mut stats,
+                    &mut timed_out,
+                );
+                exact = c;
+            }
+            let st = rollout(&start, &exact, &fl);
+            let clean = problem(final_margin, false).violation(&st) <= 1e-9;
+            let reaches = model_crossing(&start, &st, scene).is_some();
+            candidates.push(exact);
+            if (clean && reaches) || attempt == MARGIN_RETRIES || timed_out {
+                break;
+            }
+            margin *= MARGIN_GROWTH;
+            let pr = problem(margin, true);
+            let c = scp_stage(
+                pr,
+                relaxed.clone(),
+                settings.relaxed_iters,
+                settings,
+                deadline,
+                &mut stats,
+                &mut timed_out,
+            );
+            let st = rollout(&start, &c, &fl);
+            match model_crossing(&start, &st, scene) {
+                Some(k) if problem(margin, true).violation(&st) <= 1e-9 => {
+                    relaxed = c[..k].to_vec()
+                }
+                _ => {
+                    // One frame more for the wider margin.
+                    let mut longer = c;
+                    let last = *longer.last().unwrap_or(&FrameControl {
+                        sigma: 0.0,
+                        c: fl.c_max(f64::INFINITY),
+                    });
+                    longer.push(last);
+                    relaxed = longer;
+                }
+            }
+        }
+        // Stage 3: the real frame, quantised yaws, engine-exact check; keep the best valid plan.
+        for cand in candidates {
+            let trace = sim.run(&mut PlanPlayer::new(&start, cand, fl, true));
+            let t = time_of(&trace);
+            let controls = trace.controls.clone();
+            if t < best.0 && sim.run_engine_exact(&controls).feasible() {
+                best = (t, controls, trace, "optimised");
+            }
+        }
+        if best.3 == "optimised" || timed_out {
+            break;
         }
     }
     let status = if timed_out {
