@@ -70,15 +70,24 @@ fn bench_optimiser(c: &mut Criterion) {
         b.iter(|| black_box(setup.solve().predicted))
     });
     g.warm_up_time(Duration::from_millis(100));
-    g.bench_function("solve_fast_bend90_100fps", |b| {
-        b.iter(|| {
-            black_box(
-                solve(black_box(&bend), &fast)
-                    .map(|o| o.trace.crossing.map(|c| c.time))
-                    .unwrap_or_else(|e| panic!("{e}")),
-            )
-        })
-    });
+    // A full solve per quality level on the 100 fps bend. The other bends take a minute or more per solve:
+    // `strafeopt bench` measures them (CI runs these benches once each in test mode).
+    for (name, quality) in [
+        ("solve_fast_bend90_100fps", Quality::Fast),
+        ("solve_balanced_bend90_100fps", Quality::Balanced),
+        ("solve_exact_bend90_100fps", Quality::Exact),
+    ] {
+        let settings = SearchSettings::for_quality(quality);
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                black_box(
+                    solve(black_box(&bend), &settings)
+                        .map(|o| o.trace.crossing.map(|c| c.time))
+                        .unwrap_or_else(|e| panic!("{e}")),
+                )
+            })
+        });
+    }
     g.finish();
 }
 
