@@ -1,17 +1,10 @@
 //! `strafeopt calc` through the real binary: the figures of physics.md section 12 in text and `--json`,
 //! and bad input giving one line and exit code 2.
 
-use assert_cmd::Command;
 use serde_json::Value;
-use std::process::Output;
 
-/// Runs the real binary with `args`.
-fn strafeopt(args: &[&str]) -> Output {
-    Command::cargo_bin("strafeopt")
-        .map(|mut c| c.args(args).output())
-        .unwrap_or_else(|e| panic!("binary: {e}"))
-        .unwrap_or_else(|e| panic!("run {args:?}: {e}"))
-}
+mod common;
+use common::strafeopt;
 
 fn calc(args: &[&str]) -> Value {
     let full: Vec<&str> = ["calc"]

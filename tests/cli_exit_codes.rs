@@ -2,23 +2,13 @@
 //! failure writing output; 3 no valid path. Every error is exactly one line on stderr, starting with
 //! `strafeopt: `, and nothing on stdout.
 
-use assert_cmd::Command;
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
-use std::process::Output;
+
+mod common;
+use common::strafeopt;
 
 const SCENE: &str = "scenarios/hl-bend90-100fps.toml";
-
-fn strafeopt<S: AsRef<OsStr>>(args: &[S]) -> Output {
-    Command::cargo_bin("strafeopt")
-        .map(|mut c| {
-            c.current_dir(env!("CARGO_MANIFEST_DIR"))
-                .args(args)
-                .output()
-        })
-        .unwrap_or_else(|e| panic!("binary: {e}"))
-        .unwrap_or_else(|e| panic!("run: {e}"))
-}
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("strafeopt-exit-{name}-{}", std::process::id()));

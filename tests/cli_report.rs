@@ -1,22 +1,13 @@
 //! `simulate --report`, `simulate --hltas` and `report RESULT.json -o` through the real binary (issue 6).
 
-use assert_cmd::Command;
 use hltas::types::AutoMovement;
 use hltas::HLTAS;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-fn strafeopt_in(dir: &Path, args: &[&str]) -> Output {
-    Command::cargo_bin("strafeopt")
-        .map(|mut c| c.current_dir(dir).args(args).output())
-        .unwrap_or_else(|e| panic!("binary: {e}"))
-        .unwrap_or_else(|e| panic!("run {args:?}: {e}"))
-}
-
-fn strafeopt(args: &[&str]) -> Output {
-    strafeopt_in(Path::new(env!("CARGO_MANIFEST_DIR")), args)
-}
+mod common;
+use common::{strafeopt, strafeopt_in};
 
 fn ok(out: &Output, args: &[&str]) {
     assert!(

@@ -1,20 +1,10 @@
 //! `strafeopt simulate` through the real binary.
 
-use assert_cmd::Command;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Output;
 
-fn strafeopt(args: &[&str]) -> Output {
-    Command::cargo_bin("strafeopt")
-        .map(|mut c| {
-            c.current_dir(env!("CARGO_MANIFEST_DIR"))
-                .args(args)
-                .output()
-        })
-        .unwrap_or_else(|e| panic!("binary: {e}"))
-        .unwrap_or_else(|e| panic!("run {args:?}: {e}"))
-}
+mod common;
+use common::strafeopt;
 
 fn json(args: &[&str]) -> Value {
     let out = strafeopt(args);

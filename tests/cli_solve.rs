@@ -1,19 +1,9 @@
 //! `strafeopt solve` through the real binary.
 
-use assert_cmd::Command;
 use serde_json::Value;
-use std::process::Output;
 
-fn strafeopt(args: &[&str]) -> Output {
-    Command::cargo_bin("strafeopt")
-        .map(|mut c| {
-            c.current_dir(env!("CARGO_MANIFEST_DIR"))
-                .args(args)
-                .output()
-        })
-        .unwrap_or_else(|e| panic!("binary: {e}"))
-        .unwrap_or_else(|e| panic!("run {args:?}: {e}"))
-}
+mod common;
+use common::strafeopt;
 
 #[test]
 fn json_carries_every_documented_key() {
