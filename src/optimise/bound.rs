@@ -11,7 +11,9 @@
 use crate::error::{Error, Result};
 use crate::geometry::{Corridor, FinishPoint, HULL_HALF_WIDTH_UNITS};
 use crate::physics::strafe::max_accel;
-use crate::physics::{AccelLaw, Effect, Effects, MovementVars, PlayerState, Vec2};
+use crate::physics::{
+    AccelLaw, Effect, Effects, Game, MovementVars, PlayerState, Stepper, Vec2, Wish,
+};
 use crate::scene::Scene;
 pub use crate::sim::Crossing;
 use serde::Serialize;
@@ -84,6 +86,42 @@ impl SpeedBound {
         best
     }
 
+    /// The largest speed after one airborne frame from any speed up to `speed` (no jump): the clamp, then
+    /// the air FME at maximum acceleration (physics.md sections 6 and 10).
+    fn air_next(&self, speed: f64) -> f64 {
+        let s = self.clamp_speed.map_or(speed, |c| speed.min(c));
+        self.air.map_or(s, |law| s.max(max_accel(s, law).speed))
+    }
+
+    /// The largest speed after one ground frame without a jump from any speed up to `speed`: friction,
+    /// the clamp, the ground FME at maximum acceleration with wish speed `m_ups` (sections 4-6).
+    fn ground_next(&self, speed: f64, law: Option<AccelLaw>) -> f64 {
+        let s = self.clamp_speed.map_or(speed, |c| speed.min(c));
+        let l = self.lambda_max(s);
+        law.map_or(l, |law| l.max(max_accel(l, law).speed))
+    }
+
+    /// The largest speed after a jump frame from any speed up to `speed`: the Source boost (section 11)
+    /// adds at most `p |Fm| <= p Mx` below the cap `(1 + p) Mx` and `|v| - (1 + p) Mx` above it, with
+    /// `p = 0.1` and the keys cropped by `duck_multiplier` while ducked, `p <= 0.5` otherwise; then the
+    /// clamp and the air FME (the jump leaves the ground before friction, section 3).
+    fn jump_next(&self, speed: f64, ducked: Option<f64>) -> f64 {
+        let boosted = match self.jump_boost_maxspeed {
+            Some(mx) => {
+                let (p, fm) = match ducked {
+                    Some(crop) => (0.1, crop * mx),
+                    None => (0.5, mx),
+                };
+                let cap = (1.0 + p) * mx;
+                let below = (speed + p * fm).min(cap.max(speed));
+                // Above the cap the addition is `cap - |v|`, whatever p: at most `|v| - 1.1 Mx`.
+                below.max(2.0 * speed - 1.1 * mx)
+            }
+            None => speed,
+        };
+        self.air_next(boosted)
+    }
+
     /// The largest speed after friction from any speed up to `s` (friction is monotone except just above
     /// 0.1 ups, where the game's early return keeps slower crawls untouched).
     fn lambda_max(&self, s: f64) -> f64 {
@@ -126,6 +164,282 @@ pub fn time_to_cover(
     None
 }
 
+/// The schedule-aware bound of a scene with gravity, jumps and the Source jump boost (physics.md
+/// sections 3, 10, 11), far tighter than [`time_to_cover`]'s profile, which lets the boost fire on any
+/// frame. It uses what the flat floor fixes whatever the controls:
+/// - the vertical motion depends on the jump frames only (gravity, the jump speed, the 2-unit ground
+///   layer), so after a jump in frame `j` the player is airborne until frame `j + K` starts, `K` measured
+///   with the scene's own stepper; a jump needs a frame that starts on the ground;
+/// - an airborne frame runs only the air FME, a ground frame without a jump friction and the ground FME,
+///   a jump frame the boost and the air FME (the jump comes before friction, section 3);
+/// - from a ducked start the duck step keeps the player ducked until the unduck timer runs out (frame
+///   `U`, also measured): before it the ground wish speed is cropped and the boost has `p = 0.1`;
+/// - `sv_maxvelocity` clamps each component before the FME (section 10), so the progress along the unit
+///   normal `n` of the finish line in a frame is at most `tau (V_max (|n_x| + |n_y|) + gamma1)`.
+///
+/// A jump schedule fixes which frames are ground, air and jump frames, so with the largest speed of each
+/// kind of frame (every step increasing in the speed) it gives the largest speed in every frame, hence the
+/// earliest frame that schedule could cover `path_length` along the path and `progress.1` units along
+/// `n = progress.0` (the later of the two). The bound is the earliest over all schedules, found by
+/// branch and bound: the search prunes schedules already past the best crossing and uses one dominance,
+/// **jump on the landing frame once the speed is at least the ground's fixed point `s*`**: above `s*` a
+/// ground frame cannot raise the speed (`G(s) <= s`), so delaying a jump by `d` frames gives speeds no
+/// higher, frame by frame, than jumping at once (the delayed run is at most the prompt run shifted `d`
+/// frames later, and the prompt run's speed never falls). After frame `U` the steps do not depend on the
+/// frame, which the shift needs, so below `U` every choice is branched on.
+///
+/// `None` when the scene does not jump with the boost or no schedule gets there within `max_frames`
+/// (or within the search's step budget); [`lower_bound`] then falls back to [`time_to_cover`].
+pub fn jump_schedule_time_to_cover(
+    scene: &Scene,
+    path_length: f64,
+    progress: (Vec2, f64),
+) -> Option<Crossing> {
+    let (vars, fx) = (&scene.vars, scene.effects);
+    if !(fx.has(Effect::Gravity) && fx.has(Effect::Jump) && fx.has(Effect::JumpBoost)) {
+        return None;
+    }
+    let tau = vars.frame_time_s();
+    let stepper: Stepper<f64> = Stepper::new(vars, fx);
+    let idle = Wish {
+        forward: Vec2::new(1.0, 0.0),
+        ..Wish::default()
+    };
+    let probe_frames = scene.max_frames.min(MAX_SCHEDULE_PROBE_FRAMES);
+    // The first frame that starts on the ground, and the first frame that can be standing (duck released
+    // from the start).
+    let mut s = scene.start;
+    let mut first_ground = None;
+    let mut standing_from = if s.ducked { None } else { Some(1) };
+    for frame in 1..=probe_frames {
+        if s.on_ground && first_ground.is_none() {
+            first_ground = Some(frame);
+        }
+        stepper.step(&mut s, &idle);
+        if !s.ducked && standing_from.is_none() {
+            standing_from = Some(frame);
+        }
+        if first_ground.is_some() && standing_from.is_some() {
+            break;
+        }
+    }
+    let first_ground = first_ground?;
+    let standing_from = standing_from.unwrap_or(u64::MAX);
+    // The airtime K: frames from a jump frame to the next frame that starts on the ground.
+    let mut s = PlayerState::on_ground(Vec2::ZERO, Vec2::ZERO);
+    let jump = Wish { jump: true, ..idle };
+    stepper.step(&mut s, &jump);
+    let mut airtime = 1u64;
+    while !s.on_ground {
+        if airtime >= probe_frames {
+            return None;
+        }
+        stepper.step(&mut s, &idle);
+        airtime += 1;
+    }
+    let m = vars
+        .maxspeed
+        .min(vars.forward_key_speed.hypot(vars.side_key_speed));
+    let crop = vars.duck_multiplier;
+    let m_ducked = match vars.game {
+        Game::Source => crop * m,
+        Game::GoldSrc => vars
+            .maxspeed
+            .min(crop * vars.forward_key_speed.hypot(vars.side_key_speed)),
+    };
+    let law = |wish: f64| {
+        fx.has(Effect::GroundAccel)
+            .then(|| AccelLaw::ground(vars, wish))
+    };
+    let (dir, progress_units) = progress;
+    let gamma1_max = vars.entity_friction * tau * m * vars.accelerate.max(vars.airaccelerate);
+    let along_cap = if fx.has(Effect::MaxVelocity) {
+        vars.maxvelocity * (dir.x.abs() + dir.y.abs()) + gamma1_max
+    } else {
+        f64::INFINITY
+    };
+    let bound = SpeedBound::new(vars, fx);
+    let standing_law = law(m);
+    let mut search = ScheduleSearch {
+        bound,
+        tau,
+        airtime,
+        standing_from,
+        standing_law,
+        ducked_law: law(m_ducked),
+        crop,
+        ground_fixed_point: ground_fixed_point(&bound, standing_law),
+        along_cap,
+        path_length,
+        progress_units,
+        max_frames: scene.max_frames,
+        best: None,
+        steps: 0,
+    };
+    let mut run = ScheduleRun {
+        frames: 0,
+        covered: 0.0,
+        covered_along: 0.0,
+        path_done: None,
+        along_done: None,
+    };
+    // Falling towards the first landing: air frames.
+    let mut speed = scene.start.speed();
+    for _ in 1..first_ground {
+        speed = bound.air_next(speed);
+        if search.play(&mut run, speed) {
+            return search.best;
+        }
+    }
+    search.ground_phase(run, speed);
+    if search.steps > MAX_SCHEDULE_SEARCH_STEPS {
+        return None;
+    }
+    search.best
+}
+
+/// Frames [`jump_schedule_time_to_cover`] steps to find the first landing, the unduck frame and the
+/// airtime (far beyond any jump: 10 minutes at 100 fps).
+const MAX_SCHEDULE_PROBE_FRAMES: u64 = 60_000;
+/// Frames the schedule search may play in all before it gives up (its bound would still be valid, but
+/// perhaps not the earliest over all schedules).
+const MAX_SCHEDULE_SEARCH_STEPS: u64 = 50_000_000;
+
+/// The fixed point `s*` of the standing ground step `G` (friction, then maximum ground acceleration): the
+/// limit of `G` iterated from rest. `G` is increasing, so it climbs to `s*`, and above `s*` the friction
+/// `tau k s` outgrows the acceleration: `G(s) <= s` (tested).
+fn ground_fixed_point(bound: &SpeedBound, law: Option<AccelLaw>) -> f64 {
+    let mut s = 0.0;
+    for _ in 0..MAX_FIXED_POINT_ITERS {
+        let next = bound.ground_next(s, law);
+        if next <= s {
+            return s;
+        }
+        s = next;
+    }
+    s
+}
+
+/// Iterations of [`ground_fixed_point`] (the ground speed converges geometrically, by `1 - tau k` a frame).
+const MAX_FIXED_POINT_ITERS: usize = 1_000_000;
+
+/// A partial schedule's distance so far.
+#[derive(Clone, Copy, Debug)]
+struct ScheduleRun {
+    frames: u64,
+    covered: f64,
+    covered_along: f64,
+    path_done: Option<Crossing>,
+    along_done: Option<Crossing>,
+}
+
+/// The branch-and-bound search of [`jump_schedule_time_to_cover`].
+struct ScheduleSearch {
+    bound: SpeedBound,
+    tau: f64,
+    airtime: u64,
+    standing_from: u64,
+    standing_law: Option<AccelLaw>,
+    ducked_law: Option<AccelLaw>,
+    crop: f64,
+    ground_fixed_point: f64,
+    along_cap: f64,
+    path_length: f64,
+    progress_units: f64,
+    max_frames: u64,
+    best: Option<Crossing>,
+    steps: u64,
+}
+
+impl ScheduleSearch {
+    /// True when a schedule at `run` can no longer beat the best (or the budget or frame cap is spent).
+    fn pruned(&self, run: &ScheduleRun) -> bool {
+        run.frames >= self.max_frames
+            || self.steps > MAX_SCHEDULE_SEARCH_STEPS
+            || self.best.is_some_and(|b| run.frames >= b.frames)
+    }
+
+    /// Plays one frame at `speed` (the speed after the frame's FME, which the move uses). Returns true
+    /// when both distances are covered, recording the crossing if it is the best.
+    fn play(&mut self, run: &mut ScheduleRun, speed: f64) -> bool {
+        self.steps += 1;
+        run.frames += 1;
+        let tau = self.tau;
+        let (step, along) = (speed * tau, speed.min(self.along_cap) * tau);
+        let done = |covered: f64, step: f64, target: f64| {
+            (covered + step >= target).then(|| {
+                let f = if step > 0.0 {
+                    ((target - covered) / step).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                Crossing::new(run.frames, f, tau)
+            })
+        };
+        if run.path_done.is_none() {
+            run.path_done = done(run.covered, step, self.path_length);
+        }
+        if run.along_done.is_none() {
+            run.along_done = done(run.covered_along, along, self.progress_units);
+        }
+        run.covered += step;
+        run.covered_along += along;
+        match (run.path_done, run.along_done) {
+            (Some(a), Some(b)) => {
+                let c = if a.time >= b.time { a } else { b };
+                if self.best.is_none_or(|best| c.time < best.time) {
+                    self.best = Some(c);
+                }
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// The player starts frame `run.frames + 1` on the ground at `speed`: branch on jumping in it or
+    /// staying on the ground, frame by frame, until the dominance rule says jump.
+    fn ground_phase(&mut self, mut run: ScheduleRun, mut speed: f64) {
+        loop {
+            if self.pruned(&run) {
+                return;
+            }
+            let frame = run.frames + 1;
+            let ducked = frame < self.standing_from;
+            let mut jumped = run;
+            let after_jump = self.bound.jump_next(speed, ducked.then_some(self.crop));
+            if !self.play(&mut jumped, after_jump) {
+                self.air_phase(jumped, after_jump);
+            }
+            if !ducked && speed >= self.ground_fixed_point {
+                return;
+            }
+            let law = if ducked {
+                self.ducked_law
+            } else {
+                self.standing_law
+            };
+            speed = self.bound.ground_next(speed, law);
+            if self.pruned(&run) || self.play(&mut run, speed) {
+                return;
+            }
+        }
+    }
+
+    /// The frames after a jump frame until the next frame that starts on the ground.
+    fn air_phase(&mut self, mut run: ScheduleRun, mut speed: f64) {
+        for _ in 1..self.airtime {
+            if self.pruned(&run) {
+                return;
+            }
+            speed = self.bound.air_next(speed);
+            if self.play(&mut run, speed) {
+                return;
+            }
+        }
+        self.ground_phase(run, speed);
+    }
+}
+
 /// The lower bound of a scene: the shortest path of the hull centre through the corridor (walls grown by
 /// the hull) and the time the greedy speed profile needs to cover it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -154,19 +468,38 @@ pub fn lower_bound(scene: &Scene, corridor: &Corridor) -> Result<LowerBound> {
         FinishPoint::Centre => length,
         FinishPoint::Hull => (length - HULL_HALF_WIDTH_UNITS * std::f64::consts::SQRT_2).max(0.0),
     };
-    let crossing = time_to_cover(
-        &scene.vars,
-        scene.effects,
-        &scene.start,
-        path_length,
-        scene.max_frames,
-    )
-    .ok_or_else(|| {
-        Error::NoValidPath(format!(
+    // A scene with the Source boost gets the schedule-aware profile; the progress along the finish
+    // line's normal is measured from the start to the line, less the hull's reach for a `hull` finish.
+    let normal = (scene.finish.b - scene.finish.a)
+        .perp()
+        .normalized()
+        .unwrap_or(Vec2::new(1.0, 0.0));
+    let normal = if normal.dot(scene.finish.a - scene.start.pos) >= 0.0 {
+        normal
+    } else {
+        -normal
+    };
+    let reach = match scene.finish.point {
+        FinishPoint::Centre => 0.0,
+        FinishPoint::Hull => HULL_HALF_WIDTH_UNITS * (normal.x.abs() + normal.y.abs()),
+    };
+    let along = ((scene.finish.a - scene.start.pos).dot(normal) - reach).max(0.0);
+    let crossing = jump_schedule_time_to_cover(scene, path_length, (normal, along))
+        .or_else(|| {
+            time_to_cover(
+                &scene.vars,
+                scene.effects,
+                &scene.start,
+                path_length,
+                scene.max_frames,
+            )
+        })
+        .ok_or_else(|| {
+            Error::NoValidPath(format!(
             "{}: even the greedy speed profile cannot cover {path_length:.3} units in {} frames",
             scene.origin, scene.max_frames
         ))
-    })?;
+        })?;
     Ok(LowerBound {
         path_length,
         path,
@@ -194,5 +527,111 @@ mod tests {
         };
         assert!(dist(c.frames - 1) < 1000.0 && dist(c.frames) >= 1000.0);
         assert!(c.time > 0.0 && c.fraction > 0.0 && c.fraction <= 1.0);
+    }
+}
+
+#[cfg(test)]
+mod jump_schedule_tests {
+    use super::*;
+    use crate::optimise::hillclimb::XorShift64;
+    use crate::physics::Control;
+
+    fn hl2() -> (MovementVars, Effects) {
+        let mut vars = MovementVars::source_hl2(200.0 / 3.0);
+        vars.maxspeed = 150.0;
+        let fx = Effects::from_list(&[
+            Effect::AirAccel,
+            Effect::GroundAccel,
+            Effect::Friction,
+            Effect::Gravity,
+            Effect::Jump,
+            Effect::JumpBoost,
+            Effect::Duck,
+            Effect::MaxVelocity,
+        ]);
+        (vars, fx)
+    }
+
+    /// Each step bound holds for random states and controls of the stepper: an airborne frame, a ground
+    /// frame without a jump, a jump frame (standing or ducked), at speeds from rest to past the clamp.
+    #[test]
+    fn step_bounds_hold_for_random_frames() {
+        let (vars, fx) = hl2();
+        let st: Stepper<f64> = Stepper::new(&vars, fx);
+        let b = SpeedBound::new(&vars, fx);
+        let m = vars.maxspeed;
+        let crop = vars.duck_multiplier;
+        let ground = Some(AccelLaw::ground(&vars, m));
+        let mut rng = XorShift64::new(11);
+        for i in 0..20_000 {
+            let speed = 5000.0 * rng.next_f64().powi(2);
+            let dir = 2.0 * PI_F * rng.next_f64();
+            let vel = Vec2::from_angle(dir) * speed;
+            let on_ground = i % 2 == 0;
+            let mut s = if on_ground {
+                PlayerState::on_ground(Vec2::ZERO, vel)
+            } else {
+                let mut a = PlayerState::airborne(Vec2::ZERO, vel);
+                a.z = 20.0;
+                a.vz = 50.0;
+                a
+            };
+            s.ducked = rng.next_f64() < 0.5;
+            let key = |r: f64| [-450.0, 0.0, 450.0][(3.0 * r) as usize % 3];
+            let c = Control {
+                yaw_rad: 2.0 * PI_F * rng.next_f64(),
+                forwardmove: key(rng.next_f64()),
+                sidemove: key(rng.next_f64()),
+                jump: rng.next_f64() < 0.5,
+                duck: rng.next_f64() < 0.5,
+            };
+            let before = s.speed();
+            let was_ducked = s.ducked;
+            st.step(&mut s, &c.wish());
+            let ducked_in_frame = c.duck || was_ducked;
+            let limit = match (on_ground, c.jump) {
+                (false, _) => b.air_next(before),
+                (true, false) => b.ground_next(before, ground),
+                (true, true) => {
+                    let any = b.jump_next(before, None);
+                    if ducked_in_frame {
+                        any.max(b.jump_next(before, Some(crop)))
+                    } else {
+                        any
+                    }
+                }
+            };
+            assert!(
+                s.speed() <= limit * (1.0 + 1e-12) + 1e-9,
+                "frame {i}: {before} -> {} > {limit} ({c:?}, ground {on_ground})",
+                s.speed()
+            );
+            // Ducked for the whole frame: the tighter ducked jump bound holds too.
+            if on_ground && c.jump && c.duck {
+                assert!(s.speed() <= b.jump_next(before, Some(crop)) * (1.0 + 1e-12) + 1e-9);
+            }
+        }
+    }
+
+    const PI_F: f64 = std::f64::consts::PI;
+
+    /// Above the ground's fixed point a ground frame cannot raise the speed (the dominance the schedule
+    /// search relies on), and below it, it does.
+    #[test]
+    fn ground_step_falls_above_its_fixed_point() {
+        let (vars, fx) = hl2();
+        let b = SpeedBound::new(&vars, fx);
+        let law = Some(AccelLaw::ground(&vars, vars.maxspeed));
+        let s_star = ground_fixed_point(&b, law);
+        // Section 12's maximum groundstrafe speed: M sqrt(A (2 - tau A) / (k (2 - tau k))).
+        let tau = vars.frame_time_s();
+        let closed = vars.maxspeed
+            * (vars.accelerate * (2.0 - tau * vars.accelerate) / (4.0 * (2.0 - tau * 4.0))).sqrt();
+        assert!((s_star - closed).abs() < 1e-3, "{s_star} vs {closed}");
+        for i in 0..10_000 {
+            let s = s_star + 0.5 * i as f64;
+            assert!(b.ground_next(s, law) <= s + 1e-9, "{s}");
+        }
+        assert!(b.ground_next(0.5 * s_star, law) > 0.5 * s_star);
     }
 }

@@ -1,8 +1,9 @@
-//! Optimisation over control sequences: the lower bound on the time ([`bound`]) and the planning model of
-//! the minimal-time search ([`model`]).
+//! Optimisation over control sequences: the lower bound on the time ([`bound`]), the planning model of
+//! the minimal-time search ([`model`]), and the planner of jumping scenes ([`jumps`]).
 
 pub mod bound;
 pub mod hillclimb;
+pub mod jumps;
 pub mod model;
 pub mod qp;
 pub mod search;

@@ -761,6 +761,29 @@ pub fn solve_with_progress(
     // anglemod, and quantising them here could cost the frame that makes the plan no worse than greedy).
     let greedy_plan = (greedy.controls.clone(), greedy.clone());
     if !scene.effects.is_air_only() {
+        // Jumping scenes with the Source boost: the policy search of `jumps` (issue 7). It keeps a plan
+        // only if it is valid in f64 and engine-exact; greedy stays the answer when it is faster.
+        if let Some(plan) = super::jumps::plan_jumps(&sim, settings, deadline) {
+            stats.iterations = plan.evaluations;
+            let t = plan.best.time();
+            if t < time_of(&greedy_plan.1) {
+                let status = if plan.timed_out {
+                    SearchStatus::TimeLimit
+                } else {
+                    SearchStatus::Converged {
+                        gap: (t - bound.crossing.time) / bound.crossing.time.max(f64::MIN_POSITIVE),
+                    }
+                };
+                let best = plan.best;
+                return Ok(finish(
+                    best.trace.controls.clone(),
+                    best.trace,
+                    status,
+                    stats,
+                    "optimised",
+                ));
+            }
+        }
         return Ok(finish(
             greedy_plan.0,
             greedy_plan.1,
