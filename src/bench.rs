@@ -96,7 +96,7 @@ pub struct BenchRow {
     pub bound_time: f64,
     /// `(time - bound_time) / bound_time`.
     pub gap: Option<f64>,
-    /// Iterations (SCP and L-BFGS for solve, mutations for hill climbing).
+    /// Iterations (SCP sub-steps for solve, mutations for hill climbing).
     pub iterations: Option<u64>,
     /// Evaluations: Clarabel sub-problems for solve, simulations for hill climbing.
     pub evaluations: Option<u64>,

@@ -4,10 +4,10 @@
 pub mod bound;
 pub mod hillclimb;
 pub mod jumps;
+pub mod lagrangian;
 pub mod model;
 pub mod qp;
 pub mod search;
-pub mod shaping;
 pub mod substep;
 
 pub use bound::{lower_bound, LowerBound};

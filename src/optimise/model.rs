@@ -84,7 +84,22 @@ pub struct FrameJacobian {
     pub b: [[f64; 2]; 4],
 }
 
-/// A number with its derivatives with respect to `(V, psi, c, sigma)`: forward-mode differentiation.
+/// Arithmetic of forward-mode automatic differentiation over the frame's four inputs `(V, psi, c, sigma)`:
+/// the frame is written once over this trait and evaluated with [`Dual`] (first derivatives) or
+/// [`Dual2`] (first and second).
+trait Ad:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+{
+    fn constant(v: f64) -> Self;
+    fn var(v: f64, i: usize) -> Self;
+    fn value(&self) -> f64;
+    fn sqrt(self) -> Self;
+    fn sin(self) -> Self;
+    fn cos(self) -> Self;
+    fn atan2(self, x: Self) -> Self;
+}
+
+/// A number with its derivatives with respect to `(V, psi, c, sigma)`.
 #[derive(Clone, Copy, Debug)]
 struct Dual {
     v: f64,
@@ -92,6 +107,15 @@ struct Dual {
 }
 
 impl Dual {
+    fn map(self, v: f64, dv: f64) -> Dual {
+        Dual {
+            v,
+            d: self.d.map(|x| x * dv),
+        }
+    }
+}
+
+impl Ad for Dual {
     fn constant(v: f64) -> Dual {
         Dual { v, d: [0.0; 4] }
     }
@@ -100,11 +124,8 @@ impl Dual {
         d[i] = 1.0;
         Dual { v, d }
     }
-    fn map(self, v: f64, dv: f64) -> Dual {
-        Dual {
-            v,
-            d: self.d.map(|x| x * dv),
-        }
+    fn value(&self) -> f64 {
+        self.v
     }
     fn sqrt(self) -> Dual {
         let r = self.v.sqrt();
@@ -176,8 +197,199 @@ impl Div for Dual {
     }
 }
 
+/// A number with its gradient and Hessian with respect to `(V, psi, c, sigma)`: second-order forward
+/// mode, for the curvature of the frame ([`frame_hessian`]).
+#[derive(Clone, Copy, Debug)]
+struct Dual2 {
+    v: f64,
+    d: [f64; 4],
+    h: [[f64; 4]; 4],
+}
+
+impl Dual2 {
+    /// `f(self)` given `f`, `f'` and `f''` at `self.v`: `d = f' d`, `h = f' h + f'' d d^T`.
+    fn map(self, f: f64, f1: f64, f2: f64) -> Dual2 {
+        let mut h = [[0.0; 4]; 4];
+        for (i, row) in h.iter_mut().enumerate() {
+            for (j, hij) in row.iter_mut().enumerate() {
+                *hij = f1 * self.h[i][j] + f2 * self.d[i] * self.d[j];
+            }
+        }
+        Dual2 {
+            v: f,
+            d: self.d.map(|x| x * f1),
+            h,
+        }
+    }
+
+    fn recip(self) -> Dual2 {
+        let r = 1.0 / self.v;
+        self.map(r, -r * r, 2.0 * r * r * r)
+    }
+}
+
+impl Ad for Dual2 {
+    fn constant(v: f64) -> Dual2 {
+        Dual2 {
+            v,
+            d: [0.0; 4],
+            h: [[0.0; 4]; 4],
+        }
+    }
+    fn var(v: f64, i: usize) -> Dual2 {
+        let mut d = [0.0; 4];
+        d[i] = 1.0;
+        Dual2 {
+            v,
+            d,
+            h: [[0.0; 4]; 4],
+        }
+    }
+    fn value(&self) -> f64 {
+        self.v
+    }
+    fn sqrt(self) -> Dual2 {
+        let r = self.v.sqrt();
+        if r > 0.0 {
+            self.map(r, 0.5 / r, -0.25 / (r * self.v))
+        } else {
+            Dual2::constant(r)
+        }
+    }
+    fn sin(self) -> Dual2 {
+        let (s, c) = self.v.sin_cos();
+        self.map(s, c, -s)
+    }
+    fn cos(self) -> Dual2 {
+        let (s, c) = self.v.sin_cos();
+        self.map(c, -s, -c)
+    }
+    fn atan2(self, x: Dual2) -> Dual2 {
+        // theta = atan2(y, x): theta_y = x / r^2, theta_x = -y / r^2, theta_yy = -2xy / r^4,
+        // theta_xx = 2xy / r^4, theta_xy = (y^2 - x^2) / r^4.
+        let y = self;
+        let r2 = y.v * y.v + x.v * x.v;
+        if r2 <= 0.0 {
+            return Dual2::constant(y.v.atan2(x.v));
+        }
+        let r4 = r2 * r2;
+        let (ty, tx) = (x.v / r2, -y.v / r2);
+        let (tyy, txx, txy) = (
+            -2.0 * x.v * y.v / r4,
+            2.0 * x.v * y.v / r4,
+            (y.v * y.v - x.v * x.v) / r4,
+        );
+        let d = std::array::from_fn(|i| ty * y.d[i] + tx * x.d[i]);
+        let h = std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                ty * y.h[i][j]
+                    + tx * x.h[i][j]
+                    + tyy * y.d[i] * y.d[j]
+                    + txx * x.d[i] * x.d[j]
+                    + txy * (x.d[i] * y.d[j] + y.d[i] * x.d[j])
+            })
+        });
+        Dual2 {
+            v: y.v.atan2(x.v),
+            d,
+            h,
+        }
+    }
+}
+
+impl Add for Dual2 {
+    type Output = Dual2;
+    fn add(self, o: Dual2) -> Dual2 {
+        let mut r = self;
+        r.v += o.v;
+        for i in 0..4 {
+            r.d[i] += o.d[i];
+            for j in 0..4 {
+                r.h[i][j] += o.h[i][j];
+            }
+        }
+        r
+    }
+}
+
+impl Sub for Dual2 {
+    type Output = Dual2;
+    fn sub(self, o: Dual2) -> Dual2 {
+        let mut r = self;
+        r.v -= o.v;
+        for i in 0..4 {
+            r.d[i] -= o.d[i];
+            for j in 0..4 {
+                r.h[i][j] -= o.h[i][j];
+            }
+        }
+        r
+    }
+}
+
+impl Mul for Dual2 {
+    type Output = Dual2;
+    // The product rule to second order: (ab)'' = a'' b + a b'' + a' b'^T + b' a'^T.
+    #[allow(clippy::suspicious_arithmetic_impl)]
+    fn mul(self, o: Dual2) -> Dual2 {
+        let d = std::array::from_fn(|i| self.d[i] * o.v + self.v * o.d[i]);
+        let h = std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                self.h[i][j] * o.v + self.v * o.h[i][j] + self.d[i] * o.d[j] + o.d[i] * self.d[j]
+            })
+        });
+        Dual2 {
+            v: self.v * o.v,
+            d,
+            h,
+        }
+    }
+}
+
+impl Div for Dual2 {
+    type Output = Dual2;
+    // a / b = a (1 / b): the product rule and the reciprocal's second derivative.
+    #[allow(clippy::suspicious_arithmetic_impl)]
+    fn div(self, o: Dual2) -> Dual2 {
+        self * o.recip()
+    }
+}
+
 /// Smallest `V^2 - c^2` used under the square root (keeps `sin theta` real at `c = V`).
 const MIN_SIN_SQ_UPS2: f64 = 1e-18;
+
+/// The frame's outputs `(dx, dy, V', psi')` over any [`Ad`] number type, inputs `(V, psi, c, sigma)`
+/// as variables 0..3.
+fn frame_outputs<T: Ad>(x: &ModelState, u: FrameControl, fl: &FrameLaw) -> [T; 4] {
+    let v = T::var(x.speed, 0);
+    let psi = T::var(x.heading, 1);
+    let c = T::var(u.c, 2);
+    let sigma = T::var(u.sigma, 3);
+    let AccelLaw { l, gamma1 } = fl.law;
+    // mu = min(gamma1, L - c) when L - c > 0, else 0 (physics.md section 5); the piece is fixed by value.
+    let gamma2 = T::constant(l) - c;
+    let mu = if gamma2.value() <= 0.0 {
+        T::constant(0.0)
+    } else if gamma1 <= gamma2.value() {
+        T::constant(gamma1)
+    } else {
+        gamma2
+    };
+    let sin_sq = v * v - c * c;
+    let sin_sq = if sin_sq.value() > MIN_SIN_SQ_UPS2 {
+        sin_sq
+    } else {
+        T::constant(MIN_SIN_SQ_UPS2)
+    };
+    let forward = v + mu * c / v;
+    let lateral = mu * sin_sq.sqrt() / v;
+    let v_new = (forward * forward + lateral * lateral).sqrt();
+    let psi_new = psi + sigma * lateral.atan2(forward);
+    let tau = T::constant(fl.tau_s);
+    let dx = tau * v_new * psi_new.cos();
+    let dy = tau * v_new * psi_new.sin();
+    [dx, dy, v_new, psi_new]
+}
 
 /// One frame in planning variables, with its Jacobian when `jacobian` is set.
 pub fn frame(
@@ -186,40 +398,14 @@ pub fn frame(
     fl: &FrameLaw,
     jacobian: bool,
 ) -> (ModelState, Option<FrameJacobian>) {
-    let v = Dual::var(x.speed, 0);
-    let psi = Dual::var(x.heading, 1);
-    let c = Dual::var(u.c, 2);
-    let sigma = Dual::var(u.sigma, 3);
-    let AccelLaw { l, gamma1 } = fl.law;
-    // mu = min(gamma1, L - c) when L - c > 0, else 0 (physics.md section 5); the piece is fixed by value.
-    let gamma2 = Dual::constant(l) - c;
-    let mu = if gamma2.v <= 0.0 {
-        Dual::constant(0.0)
-    } else if gamma1 <= gamma2.v {
-        Dual::constant(gamma1)
-    } else {
-        gamma2
-    };
-    let sin_sq = v * v - c * c;
-    let sin_sq = if sin_sq.v > MIN_SIN_SQ_UPS2 {
-        sin_sq
-    } else {
-        Dual::constant(MIN_SIN_SQ_UPS2)
-    };
-    let forward = v + mu * c / v;
-    let lateral = mu * sin_sq.sqrt() / v;
-    let v_new = (forward * forward + lateral * lateral).sqrt();
-    let psi_new = psi + sigma * lateral.atan2(forward);
-    let tau = Dual::constant(fl.tau_s);
-    let dx = tau * v_new * psi_new.cos();
-    let dy = tau * v_new * psi_new.sin();
+    let rows: [Dual; 4] = frame_outputs(x, u, fl);
+    let [dx, dy, v_new, psi_new] = rows;
     let next = ModelState {
         pos: Vec2::new(x.pos.x + dx.v, x.pos.y + dy.v),
         speed: v_new.v,
         heading: psi_new.v,
     };
     let jac = jacobian.then(|| {
-        let rows = [dx, dy, v_new, psi_new];
         let mut a = [[0.0; 4]; 4];
         let mut b = [[0.0; 2]; 4];
         for (r, out) in rows.iter().enumerate() {
@@ -233,6 +419,33 @@ pub fn frame(
         FrameJacobian { a, b }
     });
     (next, jac)
+}
+
+/// Second derivatives of one frame: for each output `(px', py', V', psi')`, its Hessian with respect to
+/// the frame's inputs in the order `(V, psi, sigma, c)` (the position enters linearly, so its rows and
+/// columns are zero and left out). Same piece of the law as [`frame`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameHessian {
+    /// `h[output][i][j]`, symmetric in `i, j`.
+    pub h: [[[f64; 4]; 4]; 4],
+}
+
+/// Input order of [`FrameHessian`]: `(V, psi, sigma, c)`, from the automatic-differentiation order
+/// `(V, psi, c, sigma)`.
+const HESSIAN_ORDER: [usize; 4] = [0, 1, 3, 2];
+
+/// The frame's [`FrameHessian`] at `(x, u)`.
+pub fn frame_hessian(x: &ModelState, u: FrameControl, fl: &FrameLaw) -> FrameHessian {
+    let rows: [Dual2; 4] = frame_outputs(x, u, fl);
+    let mut h = [[[0.0; 4]; 4]; 4];
+    for (r, out) in rows.iter().enumerate() {
+        for (i, &ai) in HESSIAN_ORDER.iter().enumerate() {
+            for (j, &aj) in HESSIAN_ORDER.iter().enumerate() {
+                h[r][i][j] = out.h[ai][aj];
+            }
+        }
+    }
+    FrameHessian { h }
 }
 
 /// The states after each frame of `controls` from `start` (the start itself not included).
@@ -398,6 +611,60 @@ mod tests {
                 assert!((j.a[r][3] - dpsi[r]).abs() < 1e-6, "dpsi row {r}");
                 assert!((j.b[r][0] - dsig[r]).abs() < 1e-6, "dsigma row {r}");
                 assert!((j.b[r][1] - dc[r]).abs() < 1e-6, "dc row {r}");
+            }
+        }
+    }
+    #[test]
+    fn hessian_matches_finite_differences_of_the_jacobian() {
+        let (_, fl) = law(100.0);
+        let x = ModelState {
+            pos: Vec2::new(3.0, 4.0),
+            speed: 612.0,
+            heading: 0.7,
+        };
+        // Inputs in the Hessian's order (V, psi, sigma, c), and the gradient row in that order.
+        let perturb = |i: usize, h: f64, u: FrameControl| -> (ModelState, FrameControl) {
+            let (mut x, mut u) = (x, u);
+            match i {
+                0 => x.speed += h,
+                1 => x.heading += h,
+                2 => u.sigma += h,
+                _ => u.c += h,
+            }
+            (x, u)
+        };
+        let grad = |x: &ModelState, u: FrameControl| -> [[f64; 4]; 4] {
+            frame(x, u, &fl, true).1.map_or([[f64::NAN; 4]; 4], |j| {
+                std::array::from_fn(|r| [j.a[r][2], j.a[r][3], j.b[r][0], j.b[r][1]])
+            })
+        };
+        for u in [
+            FrameControl {
+                sigma: 0.3,
+                c: -1.0,
+            }, // mu = L - c piece
+            FrameControl {
+                sigma: -1.0,
+                c: -40.0,
+            }, // mu = gamma1 piece
+        ] {
+            let hess = frame_hessian(&x, u, &fl);
+            let step = 1e-5;
+            for i in 0..4 {
+                let (xp, up) = perturb(i, step, u);
+                let (xm, um) = perturb(i, -step, u);
+                let (gp, gm) = (grad(&xp, up), grad(&xm, um));
+                for r in 0..4 {
+                    for j in 0..4 {
+                        let fd = (gp[r][j] - gm[r][j]) / (2.0 * step);
+                        let h = hess.h[r][i][j];
+                        assert!(
+                            (h - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                            "output {r}, d2/d{i}d{j}: {h} vs {fd}"
+                        );
+                        assert!((h - hess.h[r][j][i]).abs() <= 1e-9 * (1.0 + h.abs()));
+                    }
+                }
             }
         }
     }

@@ -8,17 +8,22 @@
 //! linearised around the current trajectory, Clarabel solves the convexified sub-step ([`super::qp`]), and
 //! the step is accepted only after exact re-simulation confirms it (actual against predicted improvement,
 //! a trust region in between). argmin's executor owns the loop, the iteration cap and the time limit.
+//! From the second iteration on, the sub-step also carries the curvature of the Lagrangian, weighted by
+//! the last sub-step's dynamics duals and convexified ([`super::lagrangian`]): a sequential quadratic
+//! program. Its model is right to second order, so its steps are long where the linear model's were
+//! not: on the 100 fps bend 32 sub-steps instead of 283, and a better plan (4.00146 s against 4.00196 s).
 //!
 //! Stages: (1) the relaxed problem, sides continuous in `[-1, 1]`, started from the best greedy run
 //! (seeded, where the greedy speed cannot take a corner, by speed caps from the radius-speed relation);
 //! (2) sides rounded to `+-1` by tracking the relaxed heading, then `c` polished with the sides fixed;
 //! (3) yaws quantised to anglemod steps, the plan re-simulated in f64 and in the engine-exact mode.
 
+use super::lagrangian::{convexify, lagrangian_block, CurvatureBlock};
 use super::model::{
-    control_for, frame, frame_control_of, rollout, FrameControl, FrameLaw, ModelState,
+    control_for, frame, frame_control_of, frame_hessian, rollout, FrameControl, FrameLaw,
+    ModelState,
 };
 use super::qp::{self, SubProblem, SubStepStatus, WallRow};
-use super::shaping::{shape, ShapingProblem};
 use super::{lower_bound, LowerBound};
 use crate::error::{Error, Result};
 use crate::geometry::{Corridor, Separation};
@@ -57,8 +62,6 @@ pub struct SearchSettings {
     pub relaxed_iters: u64,
     /// SCP iterations of the polishing stage.
     pub polish_iters: u64,
-    /// L-BFGS iterations per penalty step of the shaping stage (0: no shaping).
-    pub shaping_iters: u64,
     /// Stop when the predicted improvement is below this, units of progress.
     pub tol_progress_units: f64,
     /// Weight of a unit of wall violation against a unit of progress.
@@ -77,7 +80,6 @@ impl SearchSettings {
             margin_units: 0.02,
             relaxed_iters: 120,
             polish_iters: 40,
-            shaping_iters: 150,
             tol_progress_units: 1e-6,
             slack_weight: 100.0,
             wall_radius_units: 40.0,
@@ -86,7 +88,6 @@ impl SearchSettings {
         match quality {
             Quality::Fast => SearchSettings {
                 relaxed_iters: 25,
-                shaping_iters: 60,
                 polish_iters: 10,
                 tol_progress_units: 1e-3,
                 ..base
@@ -96,7 +97,6 @@ impl SearchSettings {
                 margin_units: 0.01,
                 relaxed_iters: 150,
                 polish_iters: 120,
-                shaping_iters: 400,
                 tol_progress_units: 1e-9,
                 ..base
             },
@@ -206,6 +206,8 @@ struct Linearised {
     states: Vec<ModelState>,
     jacobians: Vec<super::model::FrameJacobian>,
     walls: Vec<WallRow>,
+    /// Per frame, the convexified Lagrangian block, when duals were given.
+    curvature: Option<Vec<CurvatureBlock>>,
 }
 
 fn unpack(p: &[f64]) -> Vec<FrameControl> {
@@ -248,14 +250,22 @@ impl ScpProblem<'_> {
         violation
     }
 
-    fn linearise(&self, controls: &[FrameControl]) -> Linearised {
+    /// The trajectory of `controls`, its Jacobians and wall rows, and with `duals` (one per frame, from
+    /// the last sub-problem) the convexified curvature of the Lagrangian ([`super::lagrangian`]).
+    fn linearise(&self, controls: &[FrameControl], duals: Option<&[[f64; 4]]>) -> Linearised {
         let mut states = Vec::with_capacity(controls.len());
         let mut jacobians = Vec::with_capacity(controls.len());
+        let duals = duals.filter(|z| z.len() == controls.len());
+        let mut curvature = duals.map(|_| Vec::with_capacity(controls.len()));
         let mut x = self.start;
-        for &u in controls {
+        for (k, &u) in controls.iter().enumerate() {
             let (next, j) = frame(&x, u, &self.fl, true);
             if let Some(j) = j {
                 jacobians.push(j);
+            }
+            if let (Some(blocks), Some(z)) = (curvature.as_mut(), duals) {
+                let w = lagrangian_block(&frame_hessian(&x, u, &self.fl), &z[k]);
+                blocks.push(convexify(&w));
             }
             states.push(next);
             x = next;
@@ -285,6 +295,7 @@ impl ScpProblem<'_> {
             states,
             jacobians,
             walls,
+            curvature,
         }
     }
 
@@ -321,6 +332,8 @@ pub struct ScpSolver {
     tol: f64,
     converged: bool,
     stats: SearchStats,
+    /// Dynamics duals of the last solved sub-problem, per frame: the curvature weights.
+    duals: Option<Vec<[f64; 4]>>,
 }
 
 impl ScpSolver {
@@ -333,6 +346,7 @@ impl ScpSolver {
             tol,
             converged: false,
             stats: SearchStats::default(),
+            duals: None,
         }
     }
 }
@@ -385,6 +399,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
         let controls = unpack(&param);
         let (trust, sigma_trust, c_trust) = (self.trust, self.sigma_trust, self.c_trust_ups);
         let upper_at_kink = state.get_iter() % 2 == 0;
+        let duals = self.duals.take();
         let step = problem.problem("linearise-and-solve", |pr| {
             // Each frame stays on its piece of mu = min(gamma1, L - c) within a step, so the linearisation
             // is exact to first order; a frame on the kink tries the upper piece (mu = L - c) on even
@@ -406,7 +421,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
                     }
                 })
                 .collect();
-            let lin = pr.linearise(&lin_controls);
+            let lin = pr.linearise(&lin_controls, duals.as_deref());
             let mut sigma_range = Vec::with_capacity(controls.len());
             let mut c_range = Vec::with_capacity(controls.len());
             let mut speed = pr.start.speed;
@@ -441,19 +456,26 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
                 progress_dir: pr.progress_dir,
                 sigma_range: &sigma_range,
                 c_range: &c_range,
+                curvature: lin.curvature.as_deref(),
             };
             Ok(qp::solve(&sub))
         })?;
         self.stats.iterations += 1;
         self.stats.subproblems += 1;
         let du = match step.status {
-            SubStepStatus::Solved { .. } => step.du,
+            SubStepStatus::Solved { .. } => {
+                self.duals = Some(step.dynamics_duals);
+                step.du
+            }
             SubStepStatus::Failed(_) => {
                 self.stats.subproblem_failures += 1;
                 self.trust *= 0.25;
                 return Ok((state, None));
             }
         };
+        // No gain in the merit by the model: converged. The prediction can be negative: the sub-problem
+        // also asks moves inside the wall margin back out to it, which the merit (it counts only what is
+        // closer than the accepted clearance) does not pay for.
         if step.predicted <= self.tol {
             self.converged = true;
             return Ok((state, None));
@@ -789,7 +811,8 @@ pub fn solve_with_progress(
             greedy_plan.1,
             SearchStatus::GreedyOnly {
                 reason: format!(
-                    "the optimiser plans airborne strafing only; this scene also runs {}",
+                    "the optimiser plans airborne strafing and Source jump-boost runs only; this scene also \
+                     runs {}",
                     scene.effects
                 ),
             },
@@ -848,28 +871,6 @@ pub fn solve_with_progress(
             },
         );
         stats.frame_counts_tried += 1;
-        // Shape with L-BFGS only from a start that keeps clear of the walls (from one that does not, the
-        // penalty continuation can leave the line where the SCP cannot recover it), and keep the shaped
-        // line only if its merit is better.
-        let check = problem(relaxed_margin, true);
-        let before = rollout(&start, &controls, &fl);
-        if settings.shaping_iters > 0 && check.violation(&before) <= 1e-9 {
-            let shaping = ShapingProblem {
-                start,
-                fl,
-                corridor: sim.corridor(),
-                finish_a: scene.finish.a,
-                progress_dir,
-                margin: relaxed_margin,
-                penalty: 0.0,
-                wall_radius: settings.wall_radius_units,
-            };
-            let (shaped, iters) = shape(&shaping, &controls, settings.shaping_iters);
-            stats.iterations += iters;
-            if check.merit(&rollout(&start, &shaped, &fl)) > check.merit(&before) {
-                controls = shaped;
-            }
-        }
         let pr = problem(relaxed_margin, true);
         let c = scp_stage(
             pr,

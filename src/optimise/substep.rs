@@ -139,6 +139,7 @@ impl SubStepSetup {
             progress_dir: self.progress_dir,
             sigma_range: &self.sigma_range,
             c_range: &self.c_range,
+            curvature: None,
         }
     }
 
