@@ -358,13 +358,26 @@ impl Div for Dual2 {
 /// Smallest `V^2 - c^2` used under the square root (keeps `sin theta` real at `c = V`).
 const MIN_SIN_SQ_UPS2: f64 = 1e-18;
 
-/// The frame's outputs `(dx, dy, V', psi')` over any [`Ad`] number type, inputs `(V, psi, c, sigma)`
-/// as variables 0..3.
-fn frame_outputs<T: Ad>(x: &ModelState, u: FrameControl, fl: &FrameLaw) -> [T; 4] {
-    let v = T::var(x.speed, 0);
-    let psi = T::var(x.heading, 1);
+/// The outputs `(dx, dy, V', psi')` of `frames` frames played with the same control, over any [`Ad`]
+/// number type, inputs `(V, psi, c, sigma)` as variables 0..3 (one frame: `frames = 1`).
+fn frame_outputs<T: Ad>(x: &ModelState, u: FrameControl, fl: &FrameLaw, frames: u32) -> [T; 4] {
+    let mut v = T::var(x.speed, 0);
+    let mut psi = T::var(x.heading, 1);
     let c = T::var(u.c, 2);
     let sigma = T::var(u.sigma, 3);
+    let (mut dx, mut dy) = (T::constant(0.0), T::constant(0.0));
+    for _ in 0..frames.max(1) {
+        let [fx, fy, v_new, psi_new] = one_frame(v, psi, c, sigma, fl);
+        dx = dx + fx;
+        dy = dy + fy;
+        v = v_new;
+        psi = psi_new;
+    }
+    [dx, dy, v, psi]
+}
+
+/// One frame over [`Ad`] numbers: `(dx, dy, V', psi')` from `(V, psi)` and the control `(c, sigma)`.
+fn one_frame<T: Ad>(v: T, psi: T, c: T, sigma: T, fl: &FrameLaw) -> [T; 4] {
     let AccelLaw { l, gamma1 } = fl.law;
     // mu = min(gamma1, L - c) when L - c > 0, else 0 (physics.md section 5); the piece is fixed by value.
     let gamma2 = T::constant(l) - c;
@@ -398,7 +411,19 @@ pub fn frame(
     fl: &FrameLaw,
     jacobian: bool,
 ) -> (ModelState, Option<FrameJacobian>) {
-    let rows: [Dual; 4] = frame_outputs(x, u, fl);
+    knot(x, u, fl, 1, jacobian)
+}
+
+/// A knot: `frames` frames played with the same control, as one step with the frame's interface (state
+/// in and out, Jacobian in the same four inputs). The coarse stage of the search plans over knots.
+pub fn knot(
+    x: &ModelState,
+    u: FrameControl,
+    fl: &FrameLaw,
+    frames: u32,
+    jacobian: bool,
+) -> (ModelState, Option<FrameJacobian>) {
+    let rows: [Dual; 4] = frame_outputs(x, u, fl, frames);
     let [dx, dy, v_new, psi_new] = rows;
     let next = ModelState {
         pos: Vec2::new(x.pos.x + dx.v, x.pos.y + dy.v),
@@ -436,7 +461,12 @@ const HESSIAN_ORDER: [usize; 4] = [0, 1, 3, 2];
 
 /// The frame's [`FrameHessian`] at `(x, u)`.
 pub fn frame_hessian(x: &ModelState, u: FrameControl, fl: &FrameLaw) -> FrameHessian {
-    let rows: [Dual2; 4] = frame_outputs(x, u, fl);
+    knot_hessian(x, u, fl, 1)
+}
+
+/// The [`FrameHessian`] of a [`knot`] of `frames` frames.
+pub fn knot_hessian(x: &ModelState, u: FrameControl, fl: &FrameLaw, frames: u32) -> FrameHessian {
+    let rows: [Dual2; 4] = frame_outputs(x, u, fl, frames);
     let mut h = [[[0.0; 4]; 4]; 4];
     for (r, out) in rows.iter().enumerate() {
         for (i, &ai) in HESSIAN_ORDER.iter().enumerate() {
@@ -450,10 +480,20 @@ pub fn frame_hessian(x: &ModelState, u: FrameControl, fl: &FrameLaw) -> FrameHes
 
 /// The states after each frame of `controls` from `start` (the start itself not included).
 pub fn rollout(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw) -> Vec<ModelState> {
+    rollout_knots(start, controls, fl, 1)
+}
+
+/// The states after each [`knot`] of `frames` frames of `controls` from `start`.
+pub fn rollout_knots(
+    start: &ModelState,
+    controls: &[FrameControl],
+    fl: &FrameLaw,
+    frames: u32,
+) -> Vec<ModelState> {
     let mut out = Vec::with_capacity(controls.len());
     let mut x = *start;
     for &u in controls {
-        x = frame(&x, u, fl, false).0;
+        x = knot(&x, u, fl, frames, false).0;
         out.push(x);
     }
     out
@@ -667,5 +707,56 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_knot_is_its_frames_played_in_turn() {
+        let (_, fl) = law(1000.0);
+        let x = ModelState {
+            pos: Vec2::new(3.0, 4.0),
+            speed: 612.0,
+            heading: 0.7,
+        };
+        let u = FrameControl {
+            sigma: 0.4,
+            c: -1.0,
+        };
+        let mut y = x;
+        for _ in 0..7 {
+            y = frame(&y, u, &fl, false).0;
+        }
+        let (k, j) = knot(&x, u, &fl, 7, true);
+        assert!((k.pos - y.pos).length() < 1e-9);
+        assert!((k.speed - y.speed).abs() < 1e-9 && (k.heading - y.heading).abs() < 1e-12);
+        // Its Jacobian by finite differences in sigma.
+        let h = 1e-6;
+        let plus = knot(
+            &x,
+            FrameControl {
+                sigma: u.sigma + h,
+                ..u
+            },
+            &fl,
+            7,
+            false,
+        )
+        .0;
+        let minus = knot(
+            &x,
+            FrameControl {
+                sigma: u.sigma - h,
+                ..u
+            },
+            &fl,
+            7,
+            false,
+        )
+        .0;
+        let j = j.unwrap_or(FrameJacobian {
+            a: [[f64::NAN; 4]; 4],
+            b: [[f64::NAN; 2]; 4],
+        });
+        assert!((j.b[1][0] - (plus.pos.y - minus.pos.y) / (2.0 * h)).abs() < 1e-5);
+        assert!((j.b[3][0] - (plus.heading - minus.heading) / (2.0 * h)).abs() < 1e-7);
     }
 }

@@ -13,15 +13,18 @@
 //! program. Its model is right to second order, so its steps are long where the linear model's were
 //! not: on the 100 fps bend 32 sub-steps instead of 283, and a better plan (4.00146 s against 4.00196 s).
 //!
-//! Stages: (1) the relaxed problem, sides continuous in `[-1, 1]`, started from the best greedy run
-//! (seeded, where the greedy speed cannot take a corner, by speed caps from the radius-speed relation);
+//! Stages: (0) on long runs (at least twice [`COARSE_KNOTS`] frames), coarse to fine: the relaxed problem
+//! over knots of several frames played with one control ([`knot`]: the same interface as a frame, so the
+//! same SCP), its plan spread over the frames as the next stage's start; (1) the relaxed problem, sides
+//! continuous in `[-1, 1]`, started from the best greedy run (seeded, where the greedy speed cannot take a
+//! corner, by speed caps from the radius-speed relation);
 //! (2) sides rounded to `+-1` by tracking the relaxed heading, then `c` polished with the sides fixed;
 //! (3) yaws quantised to anglemod steps, the plan re-simulated in f64 and in the engine-exact mode.
 
 use super::lagrangian::{convexify, lagrangian_block, CurvatureBlock};
 use super::model::{
-    control_for, frame, frame_control_of, frame_hessian, rollout, FrameControl, FrameLaw,
-    ModelState,
+    control_for, frame, frame_control_of, knot, knot_hessian, rollout, rollout_knots, FrameControl,
+    FrameLaw, ModelState,
 };
 use super::qp::{self, SubProblem, SubStepStatus, WallRow};
 use super::{lower_bound, LowerBound};
@@ -199,6 +202,8 @@ pub struct ScpProblem<'a> {
     slack_weight: f64,
     wall_radius: f64,
     relaxed: bool,
+    /// Frames per planning step: 1, or a coarse stage's knot ([`knot`]).
+    frames_per_knot: u32,
 }
 
 /// The trajectory of a parameter vector with what the sub-problem needs.
@@ -259,12 +264,13 @@ impl ScpProblem<'_> {
         let mut curvature = duals.map(|_| Vec::with_capacity(controls.len()));
         let mut x = self.start;
         for (k, &u) in controls.iter().enumerate() {
-            let (next, j) = frame(&x, u, &self.fl, true);
+            let (next, j) = knot(&x, u, &self.fl, self.frames_per_knot, true);
             if let Some(j) = j {
                 jacobians.push(j);
             }
             if let (Some(blocks), Some(z)) = (curvature.as_mut(), duals) {
-                let w = lagrangian_block(&frame_hessian(&x, u, &self.fl), &z[k]);
+                let hessian = knot_hessian(&x, u, &self.fl, self.frames_per_knot);
+                let w = lagrangian_block(&hessian, &z[k]);
                 blocks.push(convexify(&w));
             }
             states.push(next);
@@ -310,7 +316,7 @@ impl CostFunction for ScpProblem<'_> {
     type Output = f64;
 
     fn cost(&self, p: &Self::Param) -> std::result::Result<f64, ArgminError> {
-        let states = rollout(&self.start, &unpack(p), &self.fl);
+        let states = rollout_knots(&self.start, &unpack(p), &self.fl, self.frames_per_knot);
         let m = self.merit(&states);
         if m.is_finite() {
             Ok(-m)
@@ -840,6 +846,7 @@ pub fn solve_with_progress(
         slack_weight: settings.slack_weight,
         wall_radius: settings.wall_radius_units,
         relaxed,
+        frames_per_knot: 1,
     };
     // The warm start: the greedy (or capped greedy) run in planning variables.
     let mut vel = scene.start.vel;
@@ -852,66 +859,58 @@ pub fn solve_with_progress(
     let zigzag = fl.tau_s * fl.law.l.max(fl.law.gamma1);
     let relaxed_margin = settings.margin_units + zigzag;
     let mut n = greedy.crossing.map_or(warm.len(), |c| c.frames as usize);
-    let mut best_relaxed: Option<Vec<FrameControl>> = None;
     let mut timed_out = false;
     let mut controls = warm;
-    let mut grow_tries = 0;
     // No plan crosses before the bound's frame.
     let lo = (bound.crossing.frames as usize).saturating_sub(1);
-    loop {
-        if deadline.is_some_and(|d| Instant::now() >= d) {
-            timed_out = true;
-            break;
-        }
-        controls.resize(
-            n,
-            FrameControl {
-                sigma: 0.0,
-                c: fl.c_max(f64::INFINITY),
+    let mut search = CountSearch {
+        scene,
+        start,
+        fl,
+        settings,
+        deadline,
+        stats: &mut stats,
+        timed_out: &mut timed_out,
+        progress,
+    };
+    // Coarse to fine: on long runs, first the relaxed problem over knots of several frames each, its plan
+    // then spread over the frames as the fine stage's start.
+    let knot_frames = coarse_knot_frames(n);
+    if knot_frames > 1 {
+        let m = knot_frames as usize;
+        let knots: Vec<FrameControl> = controls[..n.min(controls.len())]
+            .chunks(m)
+            .map(|chunk| {
+                let k = chunk.len() as f64;
+                FrameControl {
+                    sigma: chunk.iter().map(|u| u.sigma).sum::<f64>() / k,
+                    c: chunk.iter().map(|u| u.c).sum::<f64>() / k,
+                }
+            })
+            .collect();
+        // The chord of a knot leaves its frames' arc by at most the sagitta m^2 tau gamma1 / 8 (each frame
+        // turns the heading by at most about gamma1 / V).
+        let sagitta = (m * m) as f64 * fl.tau_s * fl.law.gamma1 / 8.0;
+        let coarse = search.run(
+            &|margin, relaxed| ScpProblem {
+                frames_per_knot: knot_frames,
+                ..problem(margin, relaxed)
             },
+            knots.clone(),
+            knots.len(),
+            lo / m,
+            relaxed_margin + sagitta,
+            knot_frames,
         );
-        stats.frame_counts_tried += 1;
-        let pr = problem(relaxed_margin, true);
-        let c = scp_stage(
-            pr,
-            controls.clone(),
-            settings.relaxed_iters,
-            settings,
-            deadline,
-            &mut stats,
-            &mut timed_out,
-        );
-        let check = problem(relaxed_margin, true);
-        let states = rollout(&start, &c, &fl);
-        let reached = model_crossing(&start, &states, scene);
-        let clean = check.violation(&states) <= 1e-9;
-        progress(Progress::FrameCount {
-            frames: n,
-            reached: reached.filter(|_| clean),
-        });
-        match reached {
-            Some(k) if clean => {
-                best_relaxed = Some(c[..k].to_vec());
-                // One frame short of this plan's crossing, warm-started from it: each solve keeps
-                // improving the same line (stepping further on a failed probe proves nothing, the search
-                // being local).
-                if k <= lo + 1 || timed_out {
-                    break;
-                }
-                n = k - 1;
-                controls = c[..n].to_vec();
-            }
-            _ => {
-                if best_relaxed.is_some() || grow_tries >= 3 || timed_out {
-                    break;
-                }
-                // Not reachable at this N from this start: give it more frames.
-                grow_tries += 1;
-                n += (n / 20).max(2);
-                controls = c;
-            }
+        if let Some(plan) = coarse {
+            controls = plan
+                .iter()
+                .flat_map(|u| std::iter::repeat_n(*u, m))
+                .collect();
+            n = controls.len();
         }
     }
+    let best_relaxed = search.run(&problem, controls, n, lo, relaxed_margin, 1);
     let Some(relaxed) = best_relaxed else {
         return Ok(finish(
             greedy_plan.0,
@@ -1019,6 +1018,105 @@ pub fn solve_with_progress(
         }
     };
     Ok(finish(best.1, best.2, status, stats, best.3))
+}
+
+/// Frames per knot of the coarse stage for a run of about `frames` frames: knots of several frames
+/// once the run is long enough that about [`COARSE_KNOTS`] knots cover it, else 1 (no coarse stage).
+fn coarse_knot_frames(frames: usize) -> u32 {
+    u32::try_from(frames / COARSE_KNOTS)
+        .unwrap_or(u32::MAX)
+        .max(1)
+}
+
+/// About this many knots make the coarse stage (the planning steps of a 100 fps run of four seconds).
+const COARSE_KNOTS: usize = 400;
+
+/// The relaxed stage's search over the number of planning steps (frames or knots), with what it shares
+/// across the stages of a solve.
+struct CountSearch<'s, 'p> {
+    scene: &'s Scene,
+    start: ModelState,
+    fl: FrameLaw,
+    settings: &'s SearchSettings,
+    deadline: Option<Instant>,
+    stats: &'s mut SearchStats,
+    timed_out: &'s mut bool,
+    progress: &'p mut dyn FnMut(Progress),
+}
+
+impl CountSearch<'_, '_> {
+    /// From `controls` over `n` steps of `frames_per_knot` frames: SCP at `n` steps, then at one step
+    /// fewer than the plan's crossing, until the line is no longer reached (or `lo` steps, below which
+    /// the bound says it cannot be); more steps if the first count does not reach it. Returns the best
+    /// clean plan, cut at its crossing step.
+    fn run<'a>(
+        &mut self,
+        problem: &dyn Fn(f64, bool) -> ScpProblem<'a>,
+        mut controls: Vec<FrameControl>,
+        mut n: usize,
+        lo: usize,
+        margin: f64,
+        frames_per_knot: u32,
+    ) -> Option<Vec<FrameControl>> {
+        let fl = self.fl;
+        let mut best: Option<Vec<FrameControl>> = None;
+        let mut grow_tries = 0;
+        loop {
+            if self.deadline.is_some_and(|d| Instant::now() >= d) {
+                *self.timed_out = true;
+                break;
+            }
+            controls.resize(
+                n,
+                FrameControl {
+                    sigma: 0.0,
+                    c: fl.c_max(f64::INFINITY),
+                },
+            );
+            self.stats.frame_counts_tried += 1;
+            let c = scp_stage(
+                problem(margin, true),
+                controls.clone(),
+                self.settings.relaxed_iters,
+                self.settings,
+                self.deadline,
+                self.stats,
+                self.timed_out,
+            );
+            let check = problem(margin, true);
+            let states = rollout_knots(&self.start, &c, &fl, frames_per_knot);
+            let reached = model_crossing(&self.start, &states, self.scene);
+            let clean = check.violation(&states) <= 1e-9;
+            let per = frames_per_knot as usize;
+            (self.progress)(Progress::FrameCount {
+                frames: n * per,
+                reached: reached.filter(|_| clean).map(|k| k * per),
+            });
+            match reached {
+                Some(k) if clean => {
+                    best = Some(c[..k].to_vec());
+                    // One step short of this plan's crossing, warm-started from it: each solve keeps
+                    // improving the same line (stepping further on a failed probe proves nothing, the
+                    // search being local).
+                    if k <= lo + 1 || *self.timed_out {
+                        break;
+                    }
+                    n = k - 1;
+                    controls = c[..n].to_vec();
+                }
+                _ => {
+                    if best.is_some() || grow_tries >= 3 || *self.timed_out {
+                        break;
+                    }
+                    // Not reachable at this count from this start: give it more steps.
+                    grow_tries += 1;
+                    n += (n / 20).max(2);
+                    controls = c;
+                }
+            }
+        }
+        best
+    }
 }
 
 /// The best greedy run, also trying speed caps when the scene is airborne.
