@@ -41,7 +41,7 @@ use super::search::{Quality, SearchSettings};
 use crate::physics::engine_exact::quantise_yaw_rad;
 use crate::physics::strafe::{max_accel_control, strafe_keys};
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2};
-use crate::sim::abh::{boost_addition, jump_airtime_s, run_abh, AbhParams};
+use crate::sim::abh::{boost_addition, jump_airtime_s, lane_centre_line, run_abh, AbhParams};
 use crate::sim::{Controller, EngineRun, Simulation, Trace};
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -154,15 +154,11 @@ impl JumpRunner {
         }
     }
 
-    /// The lane's centre line: through the start position towards the finish line's midpoint.
+    /// The lane's centre line ([`lane_centre_line`]), fixed on the first frame.
     fn centre_line(&mut self, sim: &Simulation) -> (Vec2, Vec2) {
-        *self.line.get_or_insert_with(|| {
-            let scene = sim.scene();
-            let start = scene.start.pos;
-            let mid = (scene.finish.a + scene.finish.b) * 0.5;
-            let dir = (mid - start).normalized().unwrap_or(Vec2::new(1.0, 0.0));
-            (start, dir)
-        })
+        *self
+            .line
+            .get_or_insert_with(|| lane_centre_line(sim.scene()))
     }
 
     /// The speed across the lane (positive to the left of the lane's direction) that brings the hull
@@ -170,6 +166,19 @@ impl JumpRunner {
     fn lateral_target(offset: f64, horizon_s: f64, speed: f64) -> f64 {
         let cap = MAX_LATERAL_SHARE * speed;
         (-offset / horizon_s.max(MIN_STEER_TIME_S)).clamp(-cap, cap)
+    }
+
+    /// The strafing side (physics.md section 6: both sides gain the same speed) that turns the velocity
+    /// towards the across-lane speed target of the air steering.
+    fn steering_side(&self, s: &PlayerState, origin: Vec2, axis: Vec2) -> Side {
+        let normal = axis.perp();
+        let offset = (s.pos - origin).dot(normal);
+        let target = Self::lateral_target(offset, self.policy.steer_time_s, s.speed());
+        if s.vel.dot(normal) < target {
+            Side::Left
+        } else {
+            Side::Right
+        }
     }
 
     /// Whether the duck step of this tick leaves the player ducked, for `duck` held or not.
@@ -256,14 +265,7 @@ impl JumpRunner {
                 duck,
             };
         }
-        let normal = axis.perp();
-        let offset = (s.pos - origin).dot(normal);
-        let target = Self::lateral_target(offset, self.policy.steer_time_s, s.speed());
-        let side = if s.vel.dot(normal) < target {
-            Side::Left
-        } else {
-            Side::Right
-        };
+        let side = self.steering_side(s, origin, axis);
         let mut keys = strafe_keys(sim.scene().vars.side_key_speed);
         keys.duck = duck;
         let mut c = max_accel_control(sim.stepper(), s, keys, side, axis.angle());
@@ -291,14 +293,7 @@ impl JumpRunner {
             duck,
         };
         if walk && self.policy.ground_strafe {
-            let normal = axis.perp();
-            let offset = (s.pos - origin).dot(normal);
-            let target = Self::lateral_target(offset, self.policy.steer_time_s, s.speed());
-            let side = if s.vel.dot(normal) < target {
-                Side::Left
-            } else {
-                Side::Right
-            };
+            let side = self.steering_side(s, origin, axis);
             let mut keys = strafe_keys(0.0);
             keys.forwardmove = vars.forward_key_speed;
             keys.duck = duck;

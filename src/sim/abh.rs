@@ -115,6 +115,15 @@ pub fn jump_airtime_s(vars: &MovementVars) -> Option<f64> {
     (g > 0.0 && disc >= 0.0).then(|| (v0 + disc.sqrt()) / g)
 }
 
+/// The lane's centre line of a straight-lane scene: a point (the start position) and the unit direction
+/// towards the finish line's midpoint.
+pub fn lane_centre_line(scene: &crate::scene::Scene) -> (Vec2, Vec2) {
+    let start = scene.start.pos;
+    let mid = (scene.finish.a + scene.finish.b) * 0.5;
+    let dir = (mid - start).normalized().unwrap_or(Vec2::new(1.0, 0.0));
+    (start, dir)
+}
+
 /// The frame-level ABH controller (physics.md section 11). See the module documentation for the run.
 #[derive(Clone, Debug)]
 pub struct Abh {
@@ -140,15 +149,11 @@ impl Abh {
         }
     }
 
-    /// The lane's centre line: through the start position towards the finish line's midpoint.
+    /// The lane's centre line ([`lane_centre_line`]), fixed on the first frame.
     fn centre_line(&mut self, sim: &Simulation) -> (Vec2, Vec2) {
-        *self.line.get_or_insert_with(|| {
-            let scene = sim.scene();
-            let start = scene.start.pos;
-            let mid = (scene.finish.a + scene.finish.b) * 0.5;
-            let dir = (mid - start).normalized().unwrap_or(Vec2::new(1.0, 0.0));
-            (start, dir)
-        })
+        *self
+            .line
+            .get_or_insert_with(|| lane_centre_line(sim.scene()))
     }
 
     /// The yaw of a jump frame: the boost adds `add f`; `f` is chosen so the velocity across the lane after
