@@ -526,6 +526,25 @@ mod tests {
     use super::*;
     use crate::physics::{curvature::air_law, Effects, MovementVars, PlayerState, Stepper};
 
+    /// A state for the derivative tests.
+    const SAMPLE_STATE: ModelState = ModelState {
+        pos: Vec2::new(3.0, 4.0),
+        speed: 612.0,
+        heading: 0.7,
+    };
+
+    /// One control on each piece of `mu = min(gamma1, L - c)` at 100 fps.
+    const ONE_CONTROL_PER_PIECE: [FrameControl; 2] = [
+        FrameControl {
+            sigma: 0.3,
+            c: -1.0,
+        }, // mu = L - c piece
+        FrameControl {
+            sigma: -1.0,
+            c: -40.0,
+        }, // mu = gamma1 piece
+    ];
+
     fn law(fps: f64) -> (MovementVars, FrameLaw) {
         let vars = MovementVars::goldsrc(fps);
         (
@@ -566,21 +585,8 @@ mod tests {
     #[test]
     fn jacobian_matches_finite_differences() {
         let (_, fl) = law(100.0);
-        let x = ModelState {
-            pos: Vec2::new(3.0, 4.0),
-            speed: 612.0,
-            heading: 0.7,
-        };
-        for u in [
-            FrameControl {
-                sigma: 0.3,
-                c: -1.0,
-            }, // mu = L - c piece
-            FrameControl {
-                sigma: -1.0,
-                c: -40.0,
-            }, // mu = gamma1 piece
-        ] {
+        let x = SAMPLE_STATE;
+        for u in ONE_CONTROL_PER_PIECE {
             let (_, j) = frame(&x, u, &fl, true);
             let j = j.unwrap_or(FrameJacobian {
                 a: [[f64::NAN; 4]; 4],
@@ -657,11 +663,7 @@ mod tests {
     #[test]
     fn hessian_matches_finite_differences_of_the_jacobian() {
         let (_, fl) = law(100.0);
-        let x = ModelState {
-            pos: Vec2::new(3.0, 4.0),
-            speed: 612.0,
-            heading: 0.7,
-        };
+        let x = SAMPLE_STATE;
         // Inputs in the Hessian's order (V, psi, sigma, c), and the gradient row in that order.
         let perturb = |i: usize, h: f64, u: FrameControl| -> (ModelState, FrameControl) {
             let (mut x, mut u) = (x, u);
@@ -678,16 +680,7 @@ mod tests {
                 std::array::from_fn(|r| [j.a[r][2], j.a[r][3], j.b[r][0], j.b[r][1]])
             })
         };
-        for u in [
-            FrameControl {
-                sigma: 0.3,
-                c: -1.0,
-            }, // mu = L - c piece
-            FrameControl {
-                sigma: -1.0,
-                c: -40.0,
-            }, // mu = gamma1 piece
-        ] {
+        for u in ONE_CONTROL_PER_PIECE {
             let hess = frame_hessian(&x, u, &fl);
             let step = 1e-5;
             for i in 0..4 {
@@ -712,11 +705,7 @@ mod tests {
     #[test]
     fn a_knot_is_its_frames_played_in_turn() {
         let (_, fl) = law(1000.0);
-        let x = ModelState {
-            pos: Vec2::new(3.0, 4.0),
-            speed: 612.0,
-            heading: 0.7,
-        };
+        let x = SAMPLE_STATE;
         let u = FrameControl {
             sigma: 0.4,
             c: -1.0,
