@@ -44,6 +44,13 @@ impl Corridor {
     /// (`walls[2].points`), with `corridor` as its location since no file is known here (scene files are
     /// checked, with lines, before they get here).
     pub fn new(walls: &[Wall]) -> Result<Corridor> {
+        Self::with_half_width(walls, HULL_HALF_WIDTH_UNITS)
+    }
+
+    /// As [`Corridor::new`], with the walls grown by `half_width_units` instead of the hull's half width:
+    /// a wider body keeps its centre that much further from every wall (the optimiser's centred guide
+    /// paths use it).
+    pub fn with_half_width(walls: &[Wall], half_width_units: f64) -> Result<Corridor> {
         let mut pieces = Vec::new();
         for (w, wall) in walls.iter().enumerate() {
             if let Some(defect) = wall.defect() {
@@ -55,7 +62,7 @@ impl Corridor {
             }
             for (s, (a, b)) in wall.segments().enumerate() {
                 pieces.push(Piece {
-                    grown: GrownSegment::new(a, b, HULL_HALF_WIDTH_UNITS),
+                    grown: GrownSegment::new(a, b, half_width_units),
                     wall: w,
                     segment: s,
                     kind: wall.kind,

@@ -29,7 +29,7 @@ use super::model::{
 use super::qp::{self, SubProblem, SubStepStatus, WallRow};
 use super::{lower_bound, LowerBound};
 use crate::error::{Error, Result};
-use crate::geometry::{Corridor, Separation};
+use crate::geometry::{Corridor, Separation, HULL_HALF_WIDTH_UNITS};
 use crate::physics::curvature::{air_law, bend_arc_radius, speed_for_radius};
 use crate::physics::engine_exact::{anglemod_bracket, quantise_yaw_rad};
 use crate::physics::{Control, PlayerState, Vec2};
@@ -518,15 +518,15 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
     }
 }
 
-/// Runs SCP on `controls`; returns the improved controls, whether the time limit stopped it, and the work
-/// done.
+/// Runs SCP on `controls`; returns the improved controls, whether the time limit stopped it, whether it
+/// stopped at the iteration cap, and the work done.
 fn run_scp(
     problem: ScpProblem,
     controls: Vec<FrameControl>,
     max_iters: u64,
     tol: f64,
     deadline: Option<Instant>,
-) -> (Vec<FrameControl>, bool, SearchStats) {
+) -> (Vec<FrameControl>, bool, bool, SearchStats) {
     let x0 = pack(&controls);
     let mut exec = Executor::new(problem, ScpSolver::new(tol))
         .configure(|s| s.param(x0.clone()).max_iters(max_iters));
@@ -538,10 +538,9 @@ fn run_scp(
     }
     match exec.run() {
         Ok(res) => {
-            let timed_out = matches!(
-                res.state().get_termination_reason(),
-                Some(TerminationReason::Timeout)
-            );
+            let reason = res.state().get_termination_reason();
+            let timed_out = matches!(reason, Some(TerminationReason::Timeout));
+            let capped = matches!(reason, Some(TerminationReason::MaxItersReached));
             let best = res
                 .state()
                 .get_best_param()
@@ -553,13 +552,14 @@ fn run_scp(
                 iterations: res.state().get_iter(),
                 ..res.solver.stats
             };
-            (unpack(&best), timed_out, stats)
+            (unpack(&best), timed_out, capped, stats)
         }
-        Err(_) => (controls, false, SearchStats::default()),
+        Err(_) => (controls, false, false, SearchStats::default()),
     }
 }
 
-/// One SCP stage: runs it, adds its work to `stats`, notes a timeout; returns the improved controls.
+/// One SCP stage: runs it, adds its work to `stats`, notes a timeout; returns the improved controls and
+/// whether the stage stopped at its iteration cap (still improving) rather than converged.
 fn scp_stage(
     problem: ScpProblem,
     controls: Vec<FrameControl>,
@@ -568,8 +568,8 @@ fn scp_stage(
     deadline: Option<Instant>,
     stats: &mut SearchStats,
     timed_out: &mut bool,
-) -> Vec<FrameControl> {
-    let (c, t, s) = run_scp(
+) -> (Vec<FrameControl>, bool) {
+    let (c, t, capped, s) = run_scp(
         problem,
         controls,
         max_iters,
@@ -578,7 +578,7 @@ fn scp_stage(
     );
     add_stats(stats, s);
     *timed_out |= t;
-    c
+    (c, capped)
 }
 
 /// Sums the work counts.
@@ -741,7 +741,52 @@ pub fn solve(scene: &Scene, settings: &SearchSettings) -> Result<Outcome> {
 }
 
 /// [`solve`], reporting what it does to `progress`.
+///
+/// Where `balanced` or `exact` ends with no optimised plan valid after rounding and quantisation (their
+/// tighter tolerances can leave a line that the rounded sides cannot follow in a corridor little wider
+/// than the hull), the `fast` level is run in the time left and its plan kept if it is valid and faster.
 pub fn solve_with_progress(
+    scene: &Scene,
+    settings: &SearchSettings,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Outcome> {
+    let started = Instant::now();
+    let outcome = solve_once(scene, settings, progress)?;
+    if settings.quality == Quality::Fast
+        || !matches!(outcome.status, SearchStatus::NoImprovement { .. })
+    {
+        return Ok(outcome);
+    }
+    let time_limit = match settings.time_limit {
+        Some(limit) => match limit.checked_sub(started.elapsed()) {
+            Some(left) => Some(left),
+            None => return Ok(outcome),
+        },
+        None => None,
+    };
+    let fast = solve_once(
+        scene,
+        &SearchSettings {
+            time_limit,
+            ..SearchSettings::for_quality(Quality::Fast)
+        },
+        progress,
+    )?;
+    let work = (outcome.stats, fast.stats);
+    let mut best = if fast.source == "optimised" && time_of(&fast.trace) < time_of(&outcome.trace) {
+        fast
+    } else {
+        outcome
+    };
+    // The work of both runs.
+    best.stats = work.0;
+    add_stats(&mut best.stats, work.1);
+    best.solve_seconds = started.elapsed().as_secs_f64();
+    Ok(best)
+}
+
+/// One run of the search at `settings` (see [`solve_with_progress`]).
+fn solve_once(
     scene: &Scene,
     settings: &SearchSettings,
     progress: &mut dyn FnMut(Progress),
@@ -762,6 +807,23 @@ pub fn solve_with_progress(
         .filter_map(|&w| speed_for_radius(&scene.vars, bend_arc_radius(w)).ok())
         .collect();
     let (greedy, _, _) = best_greedy_or_capped(&sim, &bound, &caps, scene.effects.is_air_only());
+    // The search's start: the greedy run if it is valid and touches no wall (the planning model has no
+    // collisions: after a contact the model and the game part ways), else a run along a centred guide.
+    let clean = |t: &Trace| t.feasible() && t.crossing.is_some() && t.collisions() == 0;
+    let seed = if scene.effects.is_air_only() && !clean(&greedy) {
+        centred_greedy(&sim, scene, &caps, &clean)
+    } else {
+        None
+    };
+    let greedy = if seed.as_ref().is_some_and(|s| {
+        !(greedy.feasible() && greedy.crossing.is_some()) || time_of(s) <= time_of(&greedy)
+    }) {
+        // No valid greedy run, or the centred one is as fast: it is the baseline too.
+        seed.clone().unwrap_or(greedy)
+    } else {
+        greedy
+    };
+    let seed = seed.unwrap_or_else(|| greedy.clone());
     let mut stats = SearchStats::default();
     progress(Progress::Baseline {
         greedy_frames: greedy.crossing.map(|c| c.frames),
@@ -850,15 +912,15 @@ pub fn solve_with_progress(
     };
     // The warm start: the greedy (or capped greedy) run in planning variables.
     let mut vel = scene.start.vel;
-    let mut warm: Vec<FrameControl> = Vec::with_capacity(greedy.controls.len());
-    for (c, rec) in greedy.controls.iter().zip(&greedy.frames) {
+    let mut warm: Vec<FrameControl> = Vec::with_capacity(seed.controls.len());
+    for (c, rec) in seed.controls.iter().zip(&seed.frames) {
         warm.push(frame_control_of(vel, c));
         vel = rec.vel;
     }
     // Stage 1: the relaxed problem; its margin leaves room for the zigzag of rounded sides.
     let zigzag = fl.tau_s * fl.law.l.max(fl.law.gamma1);
     let relaxed_margin = settings.margin_units + zigzag;
-    let mut n = greedy.crossing.map_or(warm.len(), |c| c.frames as usize);
+    let mut n = seed.crossing.map_or(warm.len(), |c| c.frames as usize);
     let mut timed_out = false;
     let mut controls = warm;
     // No plan crosses before the bound's frame.
@@ -947,7 +1009,7 @@ pub fn solve_with_progress(
             let mut exact = round_sides(&start, &relaxed, &fl);
             if settings.polish_iters > 0 && !timed_out {
                 let pr = problem(final_margin, false);
-                let c = scp_stage(
+                let (c, _) = scp_stage(
                     pr,
                     exact.clone(),
                     settings.polish_iters,
@@ -967,7 +1029,7 @@ pub fn solve_with_progress(
             }
             margin *= MARGIN_GROWTH;
             let pr = problem(margin, true);
-            let c = scp_stage(
+            let (c, _) = scp_stage(
                 pr,
                 relaxed.clone(),
                 settings.relaxed_iters,
@@ -1028,6 +1090,10 @@ fn coarse_knot_frames(frames: usize) -> u32 {
         .max(1)
 }
 
+/// Times a relaxed stage that stopped at its iteration cap without a clean crossing is continued at the
+/// same count before the count is given up.
+const MAX_CONTINUED_STAGES: usize = 3;
+
 /// About this many knots make the coarse stage (the planning steps of a 100 fps run of four seconds).
 const COARSE_KNOTS: usize = 400;
 
@@ -1061,6 +1127,7 @@ impl CountSearch<'_, '_> {
         let fl = self.fl;
         let mut best: Option<Vec<FrameControl>> = None;
         let mut grow_tries = 0;
+        let mut continue_tries = 0;
         loop {
             if self.deadline.is_some_and(|d| Instant::now() >= d) {
                 *self.timed_out = true;
@@ -1074,7 +1141,7 @@ impl CountSearch<'_, '_> {
                 },
             );
             self.stats.frame_counts_tried += 1;
-            let c = scp_stage(
+            let (c, capped) = scp_stage(
                 problem(margin, true),
                 controls.clone(),
                 self.settings.relaxed_iters,
@@ -1104,6 +1171,12 @@ impl CountSearch<'_, '_> {
                     n = k - 1;
                     controls = c[..n].to_vec();
                 }
+                _ if capped && continue_tries < MAX_CONTINUED_STAGES && !*self.timed_out => {
+                    // The stage ran out of iterations still improving (a start far from the line: the
+                    // capped greedy run of a narrow bend at 1000 fps): go on at the same count.
+                    continue_tries += 1;
+                    controls = c;
+                }
                 _ => {
                     if best.is_some() || grow_tries >= 3 || *self.timed_out {
                         break;
@@ -1128,6 +1201,38 @@ fn best_greedy_or_capped(
 ) -> (Trace, f64, Option<f64>) {
     let caps: &[f64] = if air_only { caps } else { &[] };
     best_capped_greedy(sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS, caps)
+}
+
+/// Extra clearances of the centred guide paths, units, tried in turn when no greedy run is valid.
+const GUIDE_CLEARANCES_UNITS: [f64; 4] = [2.0, 4.0, 8.0, 12.0];
+
+/// The greedy strafer (with the speed caps) steered along a centred guide: the shortest path of a body
+/// wider than the hull by each of [`GUIDE_CLEARANCES_UNITS`] on either side, so the guide keeps that far
+/// from every wall. In a corridor only a little wider than the hull the plain guide runs along the grown
+/// inner corner, and the greedy strafer, steering by its side only, weaves across it (or, between solid
+/// walls, slides along them); the first `clean` run found is the search's start. `None` if none is.
+fn centred_greedy(
+    sim: &Simulation,
+    scene: &Scene,
+    caps: &[f64],
+    clean: &dyn Fn(&Trace) -> bool,
+) -> Option<Trace> {
+    for extra in GUIDE_CLEARANCES_UNITS {
+        let Ok(corridor) = Corridor::with_half_width(&scene.walls, HULL_HALF_WIDTH_UNITS + extra)
+        else {
+            continue;
+        };
+        let Some((_, path)) =
+            corridor.shortest_path(scene.start.pos, (scene.finish.a, scene.finish.b))
+        else {
+            continue;
+        };
+        let (t, _, _) = best_capped_greedy(sim, &path, &GREEDY_LOOKAHEADS_UNITS, caps);
+        if clean(&t) {
+            return Some(t);
+        }
+    }
+    None
 }
 
 /// The finish line's unit normal pointing the way the shortest path crosses it.
