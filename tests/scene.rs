@@ -104,6 +104,29 @@ fn shipped_ground_and_jump_scenes() {
 }
 
 #[test]
+fn shipped_sbend_scene_from_explicit_walls() {
+    let s = load("hl-sbend-100fps.toml");
+    assert_eq!(s.walls.len(), 3);
+    assert!(s.walls.iter().all(|w| w.kind == BoundaryKind::Rule));
+    assert_eq!(s.start.pos, v(40.0, 80.0));
+    assert_eq!(s.start.vel, v(320.0, 0.0));
+    assert_eq!(
+        (s.finish.a, s.finish.b),
+        (v(2400.0, 1040.0), v(2400.0, 1200.0))
+    );
+    assert!(AIR_ONLY.iter().all(|&e| s.effects.has(e)));
+    // The start is mid-lane, 80 units from both lane lines and 40 from the start wall, the nearest.
+    let clearance = s
+        .corridor()
+        .unwrap_or_else(|e| panic!("{e}"))
+        .clearance(s.start.pos);
+    assert!(
+        (clearance - (40.0 - HULL_HALF_WIDTH_UNITS)).abs() < 1e-9,
+        "{clearance}"
+    );
+}
+
+#[test]
 fn shipped_hl2_abh_scene() {
     let s = load("hl2-abh-100m.toml");
     assert_eq!(s.vars.game, Game::Source);

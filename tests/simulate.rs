@@ -16,7 +16,7 @@ fn load(name: &str) -> Scene {
 
 /// (scene, greedy frames, greedy time s, greedy valid, bound frames, bound time s), measured with
 /// `strafeopt simulate SCENE --json`.
-const PINNED: [(&str, u64, f64, bool, u64, f64); 7] = [
+const PINNED: [(&str, u64, f64, bool, u64, f64); 8] = [
     (
         "hl-bend90-1000fps-aa100",
         3188,
@@ -64,6 +64,14 @@ const PINNED: [(&str, u64, f64, bool, u64, f64); 7] = [
         false,
         422,
         4.21083683381524,
+    ),
+    (
+        "hl-sbend-100fps",
+        561,
+        5.602848635083389,
+        false,
+        547,
+        5.467776836309179,
     ),
     (
         "hl2-abh-100m",

@@ -161,3 +161,25 @@ fn between_solid_walls_the_plan_keeps_off_them() {
     assert!(plan.frames <= 411, "{plan:?}");
     assert!(plan.time >= o.bound.crossing.time);
 }
+
+#[test]
+fn the_s_bend_from_explicit_walls_takes_both_corners() {
+    // Two corners in a row: the plain greedy strafer breaks the lane in the first (frame 228), the capped
+    // one crosses in frame 619; the plan in frame 551 (fast, 5.5076 s), the bound 547 (5.4678 s).
+    let scene = load("hl-sbend-100fps");
+    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    let greedy = o
+        .greedy
+        .crossing
+        .unwrap_or_else(|| panic!("greedy never finished"));
+    assert_eq!(o.source, "optimised");
+    assert!(o.trace.feasible() && o.engine_exact.feasible() && o.greedy.feasible());
+    assert_eq!(greedy.frames, 619);
+    assert!(plan.frames <= 552, "{plan:?}");
+    assert!(
+        plan.time >= o.bound.crossing.time && plan.time < 5.51,
+        "{plan:?}"
+    );
+}
