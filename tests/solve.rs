@@ -79,6 +79,33 @@ fn the_1000fps_bend_goes_coarse_to_fine_to_the_same_level() {
 }
 
 #[test]
+fn at_1000fps_with_default_air_acceleration_the_quantised_replay_follows_the_plan() {
+    // The law's first case (gamma1 = 3.2 < L): maximum acceleration puts c on the kink, and yaws on
+    // anglemod steps lose speed every frame around it. Planned half a step under the kink, the replay
+    // crosses where the plan does: frame 3369 (exact, 3.36850 s; greedy 3887, the bound 3343). Planned on
+    // the kink, the replay fell a frame behind and exact stopped at 3370 after three wider margins.
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/hl-bend90-100fps.toml"),
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .replace("fps = 100", "fps = 1000");
+    let scene = Scene::from_toml_str(&text, "inline").unwrap_or_else(|e| panic!("{e}"));
+    let o = solve(&scene, &SearchSettings::for_quality(Quality::Exact))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    assert_eq!(o.source, "optimised");
+    assert!(plan.frames <= 3369, "{plan:?}");
+    let ee = o
+        .engine_exact
+        .crossing
+        .unwrap_or_else(|| panic!("engine-exact never finished"));
+    assert!(
+        o.engine_exact.feasible() && ee.frames == plan.frames,
+        "{ee:?} vs {plan:?}"
+    );
+}
+
+#[test]
 fn solving_twice_gives_the_same_plan() {
     let scene = load("hl-bend90-100fps");
     let s = SearchSettings::for_quality(Quality::Fast);

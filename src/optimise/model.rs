@@ -16,6 +16,9 @@
 //! about `|v|` per radian near the best angle); `(sigma, c)` are not.
 
 use crate::physics::{AccelLaw, Control, Vec2};
+
+/// One anglemod step of the yaw, radians (physics.md section 1: `360 / 65536` degrees).
+const ANGLEMOD_STEP_RAD: f64 = std::f64::consts::TAU / 65536.0;
 use std::ops::{Add, Div, Mul, Sub};
 
 /// The constants of one airborne frame: frame time and the acceleration law.
@@ -38,6 +41,24 @@ impl FrameLaw {
             (l - gamma1).min(v)
         } else {
             0.0
+        }
+    }
+
+    /// The largest `c` a plan uses at speed `v`, ups: [`FrameLaw::c_max`], less half an anglemod step of
+    /// the strafe angle (`V q / 2`, `q = 2 pi / 65536`, physics.md section 1) in case 1. There `c_max` is
+    /// the law's kink, and the game's yaw, on anglemod steps, puts the real `c` up to half a step either
+    /// side of the planned one: above the kink `mu = L - c` drops below `gamma1`, below it `c` is smaller,
+    /// and either way every frame gains less than a plan on the kink. Over thousands of frames (1000 fps)
+    /// that loss is about a frame, and a plan along a wall at its margin cannot be replayed. Half a step
+    /// under the kink, the replay can follow the plan. In case 2 `c_max = 0` is not at the kink and the
+    /// quantisation error is symmetric: no guard.
+    pub fn c_plan_max(&self, v: f64) -> f64 {
+        let AccelLaw { l, gamma1 } = self.law;
+        let c = self.c_max(v);
+        if gamma1 <= l && c >= self.kink() {
+            c - 0.5 * v * ANGLEMOD_STEP_RAD
+        } else {
+            c
         }
     }
 
@@ -747,5 +768,17 @@ mod tests {
         });
         assert!((j.b[1][0] - (plus.pos.y - minus.pos.y) / (2.0 * h)).abs() < 1e-5);
         assert!((j.b[3][0] - (plus.heading - minus.heading) / (2.0 * h)).abs() < 1e-7);
+    }
+
+    #[test]
+    fn the_plan_stays_half_an_anglemod_step_under_the_kink_only_in_case_1() {
+        // 100 fps: gamma1 = 32 > L = 30, case 2: c_max = 0, no guard.
+        let (_, fl) = law(100.0);
+        assert_eq!(fl.c_plan_max(600.0), fl.c_max(600.0));
+        // 1000 fps: gamma1 = 3.2 < L, case 1: c_max = L - gamma1 = 26.8, the kink.
+        let (_, fl) = law(1000.0);
+        let step = (360.0f64 / 65536.0).to_radians();
+        assert!((fl.c_max(600.0) - 26.8).abs() < 1e-12);
+        assert!((fl.c_max(600.0) - fl.c_plan_max(600.0) - 300.0 * step).abs() < 1e-12);
     }
 }

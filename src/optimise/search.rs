@@ -441,7 +441,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
                 let dc = trust * c_trust;
                 let (mut lo, mut hi) = (
                     dc.min(u.c - pr.c_min(speed)).max(0.0),
-                    dc.min(pr.fl.c_max(speed) - u.c).max(0.0),
+                    dc.min(pr.fl.c_plan_max(speed) - u.c).max(0.0),
                 );
                 if u.c > kink {
                     lo = lo.min(u.c - kink);
@@ -914,7 +914,13 @@ fn solve_once(
     let mut vel = scene.start.vel;
     let mut warm: Vec<FrameControl> = Vec::with_capacity(seed.controls.len());
     for (c, rec) in seed.controls.iter().zip(&seed.frames) {
-        warm.push(frame_control_of(vel, c));
+        let mut u = frame_control_of(vel, c);
+        // Below the anglemod guard of case 1, where there is one.
+        let v = vel.length();
+        if fl.c_plan_max(v) < fl.c_max(v) {
+            u.c = u.c.min(fl.c_plan_max(v));
+        }
+        warm.push(u);
         vel = rec.vel;
     }
     // Stage 1: the relaxed problem; its margin leaves room for the zigzag of rounded sides.
