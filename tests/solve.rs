@@ -4,8 +4,16 @@
 
 use std::path::Path;
 use std::time::Duration;
-use strafeopt::optimise::{solve, Quality, SearchSettings, SearchStatus};
+use strafeopt::optimise::{solve, Outcome, Quality, SearchSettings, SearchStatus};
 use strafeopt::scene::Scene;
+use strafeopt::sim::Crossing;
+
+/// `scene` solved at `quality`, with the plan's crossing.
+fn solved(scene: &Scene, quality: Quality) -> (Outcome, Crossing) {
+    let o = solve(scene, &SearchSettings::for_quality(quality)).unwrap_or_else(|e| panic!("{e}"));
+    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    (o, plan)
+}
 
 fn load(name: &str) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -17,9 +25,7 @@ fn load(name: &str) -> Scene {
 #[test]
 fn bend_100fps_beats_greedy_by_frames_and_stays_above_the_bound() {
     let scene = load("hl-bend90-100fps");
-    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    let (o, plan) = solved(&scene, Quality::Fast);
     let greedy = o
         .greedy
         .crossing
@@ -59,9 +65,7 @@ fn bend_100fps_beats_greedy_by_frames_and_stays_above_the_bound() {
 fn the_1000fps_bend_goes_coarse_to_fine_to_the_same_level() {
     // 3188 greedy frames: the search first plans over knots of 7 frames, then per frame.
     let scene = load("hl-bend90-1000fps-aa100");
-    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    let (o, plan) = solved(&scene, Quality::Fast);
     let greedy = o
         .greedy
         .crossing
@@ -90,9 +94,7 @@ fn at_1000fps_with_default_air_acceleration_the_quantised_replay_follows_the_pla
     .unwrap_or_else(|e| panic!("{e}"))
     .replace("fps = 100", "fps = 1000");
     let scene = Scene::from_toml_str(&text, "inline").unwrap_or_else(|e| panic!("{e}"));
-    let o = solve(&scene, &SearchSettings::for_quality(Quality::Exact))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    let (o, plan) = solved(&scene, Quality::Exact);
     assert_eq!(o.source, "optimised");
     assert!(plan.frames <= 3369, "{plan:?}");
     let ee = o
@@ -164,9 +166,7 @@ fn a_bend_twice_the_hull_wide_is_solved_not_called_impassable() {
     // Every greedy run, capped or not, weaves across the grown inner corner here; from the greedy run
     // along a guide kept 2-12 units off the walls the search finds frame 370 (fast; the bound 367).
     let scene = bend(64.0, 1000.0, "rule");
-    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    let (o, plan) = solved(&scene, Quality::Fast);
     assert_eq!(o.source, "optimised");
     assert!(o.trace.feasible() && o.engine_exact.feasible());
     assert!(plan.frames <= 372, "{plan:?}");
@@ -179,9 +179,7 @@ fn between_solid_walls_the_plan_keeps_off_them() {
     // collisions, so the search starts from a contact-free greedy run along a centred guide (frame 415)
     // and finds frame 410 (the bound 408).
     let scene = bend(128.0, 1200.0, "solid");
-    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    let (o, plan) = solved(&scene, Quality::Fast);
     assert_eq!(o.source, "optimised");
     assert_eq!(o.trace.collisions(), 0);
     assert!(o.engine_exact.feasible());
@@ -194,9 +192,7 @@ fn the_s_bend_from_explicit_walls_takes_both_corners() {
     // Two corners in a row: the plain greedy strafer breaks the lane in the first (frame 228), the capped
     // one crosses in frame 619; the plan in frame 551 (fast, 5.5076 s), the bound 547 (5.4678 s).
     let scene = load("hl-sbend-100fps");
-    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    let (o, plan) = solved(&scene, Quality::Fast);
     let greedy = o
         .greedy
         .crossing
