@@ -175,9 +175,9 @@ fn a_bend_twice_the_hull_wide_is_solved_not_called_impassable() {
 
 #[test]
 fn between_solid_walls_the_plan_keeps_off_them() {
-    // The greedy strafer slides along the solid outer wall (frame 427); the planning model has no
-    // collisions, so the search starts from a contact-free greedy run along a centred guide (frame 415)
-    // and finds frame 410 (the bound 408).
+    // The fastest greedy run slides along the solid outer wall (frame 427); the planning model has no
+    // collisions, so the search starts from the fastest contact-free greedy run and finds frame 410 (the
+    // bound 408). Before, it returned the sliding run.
     let scene = bend(128.0, 1200.0, "solid");
     let (o, plan) = solved(&scene, Quality::Fast);
     assert_eq!(o.source, "optimised");
@@ -205,4 +205,39 @@ fn the_s_bend_from_explicit_walls_takes_both_corners() {
         plan.time >= o.bound.crossing.time && plan.time < 5.51,
         "{plan:?}"
     );
+}
+
+/// The 160-unit bend of `hl-bend90-100fps` with the start velocity `vel`, ups.
+fn bend_from(vel: [f64; 2]) -> Scene {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/hl-bend90-100fps.toml"),
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+    .replace(
+        "[bend90]",
+        &format!("[start]\nvelocity = [{}, {}]\n\n[bend90]", vel[0], vel[1]),
+    );
+    Scene::from_toml_str(&text, "inline").unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn a_start_at_rest_is_planned_after_its_first_frame() {
+    // At rest the planning model has no heading: the seed's first frame is kept and the plan starts
+    // after it. Frame 478 (greedy 484, the bound 476); before, the search found no valid plan.
+    let (o, plan) = solved(&bend_from([0.0, 0.0]), Quality::Fast);
+    assert_eq!(o.source, "optimised");
+    assert!(o.trace.feasible() && o.engine_exact.feasible());
+    assert!(plan.frames <= 479, "{plan:?}");
+    assert!(plan.time >= o.bound.crossing.time);
+}
+
+#[test]
+fn a_start_too_fast_for_the_corner_brakes_before_it() {
+    // 1500 ups into a corner that takes about 1144: the capped greedy strafer brakes (physics.md
+    // section 7) down to its cap instead of accelerating away, and the search starts from it. Greedy 350
+    // frames, the plan 328 (fast); before, both failed and the scene was called impassable (exit 3).
+    let (o, plan) = solved(&bend_from([1500.0, 0.0]), Quality::Fast);
+    assert_eq!(o.source, "optimised");
+    assert!(o.trace.feasible() && o.engine_exact.feasible() && o.greedy.feasible());
+    assert!(plan.frames <= 330, "{plan:?}");
 }

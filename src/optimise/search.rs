@@ -34,7 +34,7 @@ use crate::physics::curvature::{air_law, bend_arc_radius, speed_for_radius};
 use crate::physics::engine_exact::{anglemod_bracket, quantise_yaw_rad};
 use crate::physics::{Control, PlayerState, Vec2};
 use crate::scene::Scene;
-use crate::sim::controllers::{best_capped_greedy, GREEDY_LOOKAHEADS_UNITS};
+use crate::sim::controllers::{best_capped_greedy, Greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{Controller, EngineRun, Simulation, Trace};
 use argmin::core::{
     CostFunction, Error as ArgminError, Executor, IterState, Problem, Solver, State,
@@ -654,6 +654,8 @@ fn round_sides(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw) -> 
 /// real state nearer the planned trajectory (position, and the heading's drift over a short horizon):
 /// replaying the relative controls on quantised yaws without this feedback drifts by tenths of a unit.
 struct PlanPlayer {
+    /// Game controls played first, as they are (see [`MIN_PLANNING_SPEED_UPS`]).
+    prefix: Vec<Control>,
     controls: Vec<FrameControl>,
     fl: FrameLaw,
     quantise: bool,
@@ -661,9 +663,16 @@ struct PlanPlayer {
 }
 
 impl PlanPlayer {
-    fn new(start: &ModelState, controls: Vec<FrameControl>, fl: FrameLaw, quantise: bool) -> Self {
+    fn new(
+        start: &ModelState,
+        prefix: &[Control],
+        controls: Vec<FrameControl>,
+        fl: FrameLaw,
+        quantise: bool,
+    ) -> Self {
         let targets = rollout(start, &controls, &fl);
         PlanPlayer {
+            prefix: prefix.to_vec(),
             controls,
             fl,
             quantise,
@@ -679,6 +688,10 @@ impl Controller for PlanPlayer {
 
     fn control(&mut self, frame: u64, s: &PlayerState, sim: &Simulation) -> Control {
         let i = usize::try_from(frame.saturating_sub(1)).unwrap_or(usize::MAX);
+        if let Some(c) = self.prefix.get(i) {
+            return *c;
+        }
+        let i = i - self.prefix.len();
         let u = self.controls.get(i).copied().unwrap_or(FrameControl {
             sigma: 1.0,
             c: self.fl.c_max(s.speed()),
@@ -888,11 +901,23 @@ fn solve_once(
             "greedy",
         ));
     }
+    // A start at rest has no heading, and the planning model none to turn: the seed's first frame
+    // (from rest every wish direction gains the same) is kept as a fixed prefix and planning starts
+    // after it.
+    let prefix: Vec<Control> = if scene.start.speed() < MIN_PLANNING_SPEED_UPS {
+        seed.controls.iter().take(1).copied().collect()
+    } else {
+        Vec::new()
+    };
+    let (start_pos, start_vel) = match (prefix.len(), seed.frames.first()) {
+        (1, Some(first)) => (first.pos, first.vel),
+        _ => (scene.start.pos, scene.start.vel),
+    };
     let start = ModelState {
-        pos: scene.start.pos,
-        speed: scene.start.speed(),
-        heading: if scene.start.speed() > 0.0 {
-            scene.start.vel.angle()
+        pos: start_pos,
+        speed: start_vel.length(),
+        heading: if start_vel.length() > 0.0 {
+            start_vel.angle()
         } else {
             0.0
         },
@@ -911,9 +936,9 @@ fn solve_once(
         frames_per_knot: 1,
     };
     // The warm start: the greedy (or capped greedy) run in planning variables.
-    let mut vel = scene.start.vel;
+    let mut vel = start_vel;
     let mut warm: Vec<FrameControl> = Vec::with_capacity(seed.controls.len());
-    for (c, rec) in seed.controls.iter().zip(&seed.frames) {
+    for (c, rec) in seed.controls.iter().zip(&seed.frames).skip(prefix.len()) {
         let mut u = frame_control_of(vel, c);
         // Below the anglemod guard of case 1, where there is one.
         let v = vel.length();
@@ -926,11 +951,13 @@ fn solve_once(
     // Stage 1: the relaxed problem; its margin leaves room for the zigzag of rounded sides.
     let zigzag = fl.tau_s * fl.law.l.max(fl.law.gamma1);
     let relaxed_margin = settings.margin_units + zigzag;
-    let mut n = seed.crossing.map_or(warm.len(), |c| c.frames as usize);
+    let mut n = seed.crossing.map_or(warm.len(), |c| {
+        (c.frames as usize).saturating_sub(prefix.len())
+    });
     let mut timed_out = false;
     let mut controls = warm;
     // No plan crosses before the bound's frame.
-    let lo = (bound.crossing.frames as usize).saturating_sub(1);
+    let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix.len());
     let mut search = CountSearch {
         scene,
         start,
@@ -1063,7 +1090,7 @@ fn solve_once(
         }
         // Stage 3: the real frame, quantised yaws, engine-exact check; keep the best valid plan.
         for cand in candidates {
-            let trace = sim.run(&mut PlanPlayer::new(&start, cand, fl, true));
+            let trace = sim.run(&mut PlanPlayer::new(&start, &prefix, cand, fl, true));
             let t = time_of(&trace);
             let controls = trace.controls.clone();
             if t < best.0 && sim.run_engine_exact(&controls).feasible() {
@@ -1095,6 +1122,10 @@ fn coarse_knot_frames(frames: usize) -> u32 {
         .unwrap_or(u32::MAX)
         .max(1)
 }
+
+/// Below this start speed, ups, the planning model has no heading to work from: the seed's first frame is
+/// played as it is and the plan starts after it.
+const MIN_PLANNING_SPEED_UPS: f64 = 1.0;
 
 /// Times a relaxed stage that stopped at its iteration cap without a clean crossing is continued at the
 /// same count before the count is given up.
@@ -1209,14 +1240,16 @@ fn best_greedy_or_capped(
     best_capped_greedy(sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS, caps)
 }
 
-/// Extra clearances of the centred guide paths, units, tried in turn when no greedy run is valid.
-const GUIDE_CLEARANCES_UNITS: [f64; 4] = [2.0, 4.0, 8.0, 12.0];
+/// Extra clearances of the guide paths, units, tried in turn when the best greedy run is not clean.
+const GUIDE_CLEARANCES_UNITS: [f64; 5] = [0.0, 2.0, 4.0, 8.0, 12.0];
 
-/// The greedy strafer (with the speed caps) steered along a centred guide: the shortest path of a body
-/// wider than the hull by each of [`GUIDE_CLEARANCES_UNITS`] on either side, so the guide keeps that far
-/// from every wall. In a corridor only a little wider than the hull the plain guide runs along the grown
-/// inner corner, and the greedy strafer, steering by its side only, weaves across it (or, between solid
-/// walls, slides along them); the first `clean` run found is the search's start. `None` if none is.
+/// The fastest `clean` run of the greedy strafer (every look-ahead, uncapped and with each speed cap)
+/// along a guide: the shortest path of a body wider than the hull by each of [`GUIDE_CLEARANCES_UNITS`]
+/// on either side in turn, so the guide keeps that far from every wall; the first guide with a clean run
+/// gives it. Needed where the best greedy run is not clean: in a corridor only a little wider than the
+/// hull the plain guide runs along the grown inner corner and the greedy strafer, steering by its side
+/// only, weaves across it; between solid walls the fastest greedy runs slide along them, which the
+/// planning model (no collisions) cannot follow. `None` if no run is clean.
 fn centred_greedy(
     sim: &Simulation,
     scene: &Scene,
@@ -1233,9 +1266,21 @@ fn centred_greedy(
         else {
             continue;
         };
-        let (t, _, _) = best_capped_greedy(sim, &path, &GREEDY_LOOKAHEADS_UNITS, caps);
-        if clean(&t) {
-            return Some(t);
+        let mut best: Option<Trace> = None;
+        for cap in std::iter::once(None).chain(caps.iter().copied().map(Some)) {
+            for &la in &GREEDY_LOOKAHEADS_UNITS {
+                let greedy = Greedy::new(path.clone(), la);
+                let t = sim.run(&mut match cap {
+                    Some(cap) => greedy.with_speed_cap(cap),
+                    None => greedy,
+                });
+                if clean(&t) && best.as_ref().is_none_or(|b| time_of(&t) < time_of(b)) {
+                    best = Some(t);
+                }
+            }
+        }
+        if best.is_some() {
+            return best;
         }
     }
     None

@@ -3,8 +3,8 @@
 
 use super::{Controller, Simulation, Trace};
 use crate::physics::strafe::{
-    max_accel, max_accel_control, speed_preserving_cos_theta, strafe_control, strafe_keys,
-    theta_from_cos,
+    max_accel, max_accel_control, max_decel, speed_preserving_cos_theta, strafe_control,
+    strafe_keys, theta_from_cos,
 };
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2, Wish};
 
@@ -186,8 +186,18 @@ impl Controller for Greedy {
                     scene_keys(sim),
                     to_target.angle(),
                     |lambda, law| {
-                        let cos = speed_preserving_cos_theta(before.min(cap), lambda, law)
-                            .unwrap_or_else(|| max_accel(lambda, law).cos_theta);
+                        // Back to the cap, or held there; where one frame cannot reach it, as near as a
+                        // frame gets: braking (section 7) from above (a fast start before a corner),
+                        // accelerating from below.
+                        let target = before.min(cap);
+                        let cos =
+                            speed_preserving_cos_theta(target, lambda, law).unwrap_or_else(|| {
+                                if target < lambda {
+                                    max_decel(lambda, law).0
+                                } else {
+                                    max_accel(lambda, law).cos_theta
+                                }
+                            });
                         side.sign() * theta_from_cos(cos)
                     },
                 )
