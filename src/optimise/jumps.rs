@@ -47,8 +47,6 @@ use serde::Serialize;
 use std::f64::consts::PI;
 use std::time::Instant;
 
-/// Slack on the unduck timer, seconds (the frame step's own slack).
-const UNDUCK_TOL_S: f64 = 1e-9;
 /// Largest speed across the lane the steering asks for, as a share of the speed.
 const MAX_LATERAL_SHARE: f64 = 0.25;
 /// Smallest steering horizon, seconds (guards the division).
@@ -181,13 +179,6 @@ impl JumpRunner {
         }
     }
 
-    /// Whether the duck step of this tick leaves the player ducked, for `duck` held or not.
-    fn ducked_after_duck_step(s: &PlayerState, duck: bool, sim: &Simulation) -> bool {
-        let vars = &sim.scene().vars;
-        duck || (s.ducked
-            && s.unduck_elapsed_s + sim.scene().frame_time_s() < vars.unduck_time_s - UNDUCK_TOL_S)
-    }
-
     /// A jump tick (physics.md section 11): the boost's signed addition `add` does not depend on the view,
     /// so the view is chosen to point `add f` where the boost should go: along the lane, or bent so that
     /// the speed across the lane afterwards returns the hull to the centre line. A strafe key, if held,
@@ -208,7 +199,7 @@ impl JumpRunner {
         } else {
             0.0
         };
-        let ducked = Self::ducked_after_duck_step(s, duck, sim);
+        let ducked = sim.stepper().ducked_after_duck_step(s, duck);
         // The clamp of the first gravity half-step comes before the boost.
         let mut vel = s.vel;
         if sim.scene().effects.has(Effect::MaxVelocity) {
@@ -283,7 +274,7 @@ impl JumpRunner {
         } else {
             self.policy.kind(self.jumps) == JumpKind::Ducked
         };
-        let ducked = Self::ducked_after_duck_step(s, duck, sim);
+        let ducked = sim.stepper().ducked_after_duck_step(s, duck);
         let walk = self.jumps == 0 && (!ducked || duck || self.policy.walk_while_unducking);
         let mut c = Control {
             yaw_rad: axis.angle(),

@@ -91,6 +91,18 @@ pub struct SubStep {
 /// A control's allowed change at most this wide (scaled units) counts as none: the control is fixed.
 const FIXED_RANGE: f64 = 1e-12;
 
+impl SubStep {
+    /// A sub-step with no step: `status` says why.
+    fn failed(status: SubStepStatus) -> SubStep {
+        SubStep {
+            status,
+            du: vec![],
+            predicted: 0.0,
+            dynamics_duals: vec![],
+        }
+    }
+}
+
 /// Interior-point iterations Clarabel may take on one sub-problem.
 pub const MAX_SUBPROBLEM_ITERATIONS: u32 = 200;
 
@@ -169,14 +181,12 @@ pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
     }
     let n_eq = row;
     // Walls: -n . dp_k - s_j <= n . p_k - offset - margin.
-    let mut slack0 = 0.0;
     for (j, w) in sp.walls.iter().enumerate() {
         let p = sp.positions[w.frame];
         ri.extend([row, row, row]);
         ci.extend([ix(w.frame, 0), ix(w.frame, 1), is(j)]);
         vals.extend([-w.plane.normal.x, -w.plane.normal.y, -1.0]);
         let rhs = w.plane.side(p) - sp.margin;
-        slack0 += (-rhs).max(0.0);
         b.push(rhs);
         row += 1;
     }
@@ -260,25 +270,11 @@ pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
         .build()
     {
         Ok(s) => s,
-        Err(e) => {
-            return SubStep {
-                status: SubStepStatus::Failed(format!("settings: {e}")),
-                du: vec![],
-                predicted: 0.0,
-                dynamics_duals: vec![],
-            }
-        }
+        Err(e) => return SubStep::failed(SubStepStatus::Failed(format!("settings: {e}"))),
     };
     let mut solver = match DefaultSolver::new(&p, &q, &a, &b, &cones, settings) {
         Ok(s) => s,
-        Err(e) => {
-            return SubStep {
-                status: SubStepStatus::Failed(format!("setup: {e:?}")),
-                du: vec![],
-                predicted: 0.0,
-                dynamics_duals: vec![],
-            }
-        }
+        Err(e) => return SubStep::failed(SubStepStatus::Failed(format!("setup: {e:?}"))),
     };
     solver.solve();
     let status = match solver.solution.status {
@@ -304,12 +300,7 @@ pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
             SubStepStatus::Solved { .. } => SubStepStatus::Failed("non-finite solution".into()),
             s => s,
         };
-        return SubStep {
-            status,
-            du: vec![],
-            predicted: 0.0,
-            dynamics_duals: vec![],
-        };
+        return SubStep::failed(status);
     }
     let du: Vec<(f64, f64)> = (0..n)
         .map(|k| (x[iu(k, 0)], x[iu(k, 1)] * C_SCALE_UPS))
@@ -330,7 +321,6 @@ pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
         viol_before += (sp.accepted_clearance - side).max(0.0);
         viol_after += (sp.accepted_clearance - side - dp).max(0.0);
     }
-    let _ = slack0;
     // The model's second-order term, 0.5 d' W d, over the curvature blocks.
     let mut curvature_term = 0.0;
     if let Some(blocks) = sp.curvature {

@@ -833,13 +833,10 @@ fn solve_once(
     } else {
         None
     };
-    let greedy = if seed.as_ref().is_some_and(|s| {
-        !(greedy.feasible() && greedy.crossing.is_some()) || time_of(s) <= time_of(&greedy)
-    }) {
-        // No valid greedy run, or the centred one is as fast: it is the baseline too.
-        seed.clone().unwrap_or(greedy)
-    } else {
-        greedy
+    // The baseline is the faster valid run of the two (`time_of` is infinite for an invalid one).
+    let greedy = match &seed {
+        Some(s) if time_of(s) <= time_of(&greedy) => s.clone(),
+        _ => greedy,
     };
     let seed = seed.unwrap_or_else(|| greedy.clone());
     let mut stats = SearchStats::default();

@@ -1,6 +1,7 @@
 //! The accelerated-backhop article's model (physics.md section 11): each hop lasts a fixed time at constant
 //! speed, and each backhop's jump boost maps `|v|` to `2|v| - 1.1 Mx`, clamped to `sv_maxvelocity`.
 
+use super::real::Real;
 use serde::Serialize;
 
 /// One hop of the article's model.
@@ -25,19 +26,53 @@ pub struct AbhArticle {
     pub landing_past_line: f64,
 }
 
-/// Speed after a jump with the Source boost (physics.md section 11) for forwardmove `fm` along the view,
-/// speed `speed` along the view's axis, `p = 0.1` ducked or sprinting else `0.5`, max speed `mx`.
-/// Facing backwards, `fm = 0`, ducked: `2|v| - 1.1 Mx` when `|v| > 1.1 Mx`.
-pub fn boosted_speed(speed: f64, fm: f64, p: f64, mx: f64, facing_backwards: bool) -> f64 {
+/// The boost's signed addition along the view, ups (physics.md section 11), for the effective forwardmove
+/// `fm`, `p` (0.1 ducked or sprinting, else 0.5), max speed `mx` and horizontal speed `speed`:
+/// `add = |Fm p|`, cut so the new speed does not pass `Mx (1 + p)`, negated for a backwards key. Written
+/// once over [`Real`] for the frame step (`f64` and `f32`), the frame-level planners and the article's
+/// model.
+pub fn boost_add<R: Real>(fm: R, p: R, mx: R, speed: R) -> R {
     let mut add = (fm * p).abs();
     let cap = mx + mx * p;
     let new = add + speed;
     if new > cap {
         add -= new - cap;
     }
-    if fm < 0.0 {
-        add = -add;
+    if fm < R::ZERO {
+        -add
+    } else {
+        add
     }
+}
+
+/// [`boost_add`] as the frame computes it from the keys: forwardmove scaled down to the max speed together
+/// with sidemove (`CheckParameters`), cropped by `duck_crop` when ducked (`HandleDuckingSpeedCrop`),
+/// `p = 0.1` ducked else `0.5`.
+pub fn boost_add_from_keys<R: Real>(
+    forwardmove: R,
+    sidemove: R,
+    mx: R,
+    ducked: bool,
+    duck_crop: R,
+    speed: R,
+) -> R {
+    let len = forwardmove.hypot(sidemove);
+    let mut fm = forwardmove;
+    if len > mx {
+        fm = fm * (mx / len);
+    }
+    if ducked {
+        fm = fm * duck_crop;
+    }
+    let p = R::from_f64(if ducked { 0.1 } else { 0.5 });
+    boost_add(fm, p, mx, speed)
+}
+
+/// Speed after a jump with the Source boost (physics.md section 11) for forwardmove `fm` along the view,
+/// speed `speed` along the view's axis, `p = 0.1` ducked or sprinting else `0.5`, max speed `mx`.
+/// Facing backwards, `fm = 0`, ducked: `2|v| - 1.1 Mx` when `|v| > 1.1 Mx`.
+pub fn boosted_speed(speed: f64, fm: f64, p: f64, mx: f64, facing_backwards: bool) -> f64 {
+    let add = boost_add(fm, p, mx, speed);
     if facing_backwards {
         speed - add
     } else {

@@ -6,6 +6,7 @@
 //! The horizontal move (step 5) is split out: [`Stepper::step`] moves freely, while a simulation with walls
 //! calls [`Stepper::pre_move`], sweeps the hull itself, then calls [`Stepper::post_move`].
 
+use super::abh::boost_add_from_keys;
 use super::effects::{Effect, Effects};
 use super::real::Real;
 use super::vars::{
@@ -441,6 +442,18 @@ impl<R: Real> Stepper<R> {
         }
     }
 
+    /// Whether the duck step of the next frame (step 1) leaves the player ducked, with duck `held` or
+    /// not: the controllers that must know it before the frame (the Source boost's `p`) ask here rather
+    /// than repeat the unduck timer.
+    pub fn ducked_after_duck_step(&self, s: &PlayerState<R>, held: bool) -> bool {
+        if !self.effects.has(Effect::Duck) {
+            return s.ducked;
+        }
+        let mut next = *s;
+        self.duck(&mut next, held);
+        next.ducked
+    }
+
     fn duck(&self, s: &mut PlayerState<R>, held: bool) {
         if held {
             s.ducked = true;
@@ -471,27 +484,21 @@ impl<R: Real> Stepper<R> {
         }
     }
 
-    /// The Source jump boost (physics.md section 11).
+    /// The Source jump boost (physics.md section 11); the duck crop applies when the duck effect runs.
     fn jump_boost(&self, s: &mut PlayerState<R>, w: &Wish<R>) {
-        // CheckParameters scales the keys down to the max speed; the duck crop applies on the ground.
-        let len = w.forwardmove.hypot(w.sidemove);
-        let mut fm = w.forwardmove;
-        if len > self.maxspeed {
-            fm = fm * (self.maxspeed / len);
-        }
-        if s.ducked && self.effects.has(Effect::Duck) {
-            fm = fm * self.duck_multiplier;
-        }
-        let p = R::from_f64(if s.ducked { 0.1 } else { 0.5 });
-        let mut add = (fm * p).abs();
-        let cap = self.maxspeed + self.maxspeed * p;
-        let new = add + s.vel.length();
-        if new > cap {
-            add -= new - cap;
-        }
-        if fm < R::ZERO {
-            add = -add;
-        }
+        let crop = if self.effects.has(Effect::Duck) {
+            self.duck_multiplier
+        } else {
+            R::ONE
+        };
+        let add = boost_add_from_keys(
+            w.forwardmove,
+            w.sidemove,
+            self.maxspeed,
+            s.ducked,
+            crop,
+            s.vel.length(),
+        );
         s.vel += w.forward * add;
     }
 

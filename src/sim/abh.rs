@@ -31,6 +31,7 @@
 //! yaws are put on anglemod steps (physics.md section 1) so the engine-exact replay sees the same view.
 
 use super::{Controller, EngineRun, Simulation, Trace};
+use crate::physics::abh::boost_add_from_keys;
 use crate::physics::engine_exact::quantise_yaw_rad;
 use crate::physics::{Control, MovementVars, PlayerState, Vec2};
 use serde::Serialize;
@@ -40,8 +41,6 @@ use std::f64::consts::PI;
 const MAX_LATERAL_UPS: f64 = 50.0;
 /// Slack on the walk-speed threshold, ups: the ground FME reaches `M` only up to rounding.
 const WALK_SPEED_TOL_UPS: f64 = 1e-6;
-/// Slack on the unduck timer, seconds (the frame step's own slack).
-const UNDUCK_TOL_S: f64 = 1e-9;
 /// The ground layer the airtime estimate falls back to, units (physics.md section 3, step 6).
 const GROUND_LAYER_UNITS: f64 = 2.0;
 
@@ -74,10 +73,8 @@ impl Default for AbhParams {
     }
 }
 
-/// The boost's signed addition along the view, ups (physics.md section 11), as the frame computes it:
-/// forwardmove scaled down to the max speed (`CheckParameters`), cropped by the duck multiplier when
-/// ducked (`HandleDuckingSpeedCrop`, on the ground), `p = 0.1` ducked else `0.5`, the addition cut so the
-/// new speed does not pass `Mx (1 + p)`, negated for a backwards key.
+/// The boost's signed addition along the view, ups (physics.md section 11), as the frame computes it
+/// ([`boost_add_from_keys`]) with the scene's max speed and duck multiplier.
 pub fn boost_addition(
     vars: &MovementVars,
     ducked: bool,
@@ -85,26 +82,14 @@ pub fn boost_addition(
     sidemove: f64,
     speed: f64,
 ) -> f64 {
-    let mx = vars.maxspeed;
-    let len = forwardmove.hypot(sidemove);
-    let mut fm = forwardmove;
-    if len > mx {
-        fm *= mx / len;
-    }
-    if ducked {
-        fm *= vars.duck_multiplier;
-    }
-    let p = if ducked { 0.1 } else { 0.5 };
-    let mut add = (fm * p).abs();
-    let cap = mx + mx * p;
-    let new = add + speed;
-    if new > cap {
-        add -= new - cap;
-    }
-    if fm < 0.0 {
-        add = -add;
-    }
-    add
+    boost_add_from_keys(
+        forwardmove,
+        sidemove,
+        vars.maxspeed,
+        ducked,
+        vars.duck_multiplier,
+        speed,
+    )
 }
 
 /// Time from a jump back to the 2-unit ground layer, seconds (physics.md section 10, with the scene's jump
@@ -209,9 +194,7 @@ impl Controller for Abh {
                 let threshold = self.params.walk_speed_ups.unwrap_or(vars.maxspeed);
                 // The duck step runs first in the frame, so the frame in which the unduck timer
                 // completes is already a standing frame.
-                let tau = sim.scene().frame_time_s();
-                let standing =
-                    !s.ducked || s.unduck_elapsed_s + tau >= vars.unduck_time_s - UNDUCK_TOL_S;
+                let standing = !sim.stepper().ducked_after_duck_step(s, false);
                 if !standing {
                     // Standing up (TIME_TO_UNDUCK).
                     if self.params.walk_while_unducking {
