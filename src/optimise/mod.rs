@@ -1,14 +1,21 @@
 //! Optimisation over control sequences: the lower bound on the time ([`bound`]), the planning model of
 //! the minimal-time search ([`model`]), and the planner of jumping scenes ([`jumps`]).
 
+mod baseline;
 pub mod bound;
 pub mod hillclimb;
 pub mod jumps;
 pub mod lagrangian;
 pub mod model;
+mod planner;
+mod polish;
 pub mod qp;
+mod relaxed;
+mod rounding;
+pub mod scp;
 pub mod search;
 pub mod substep;
+mod verify;
 
 pub use bound::{lower_bound, LowerBound};
 pub use search::{

@@ -1,0 +1,177 @@
+//! What the stages of an airborne solve share: where planning starts, the frame law, the corridor, the
+//! direction of progress, the settings, the deadline and the work done so far.
+
+use super::model::{frame_control_of, FrameControl, FrameLaw, ModelState};
+use super::scp::{scp_stage, ScpProblem};
+use super::search::{SearchSettings, SearchStats};
+use super::LowerBound;
+use crate::physics::curvature::air_law;
+use crate::physics::{Control, Vec2};
+use crate::scene::Scene;
+use crate::sim::{Simulation, Trace};
+use std::time::Instant;
+
+/// Below this start speed, ups, the planning model has no heading to work from: the seed's first frame is
+/// played as it is and the plan starts after it.
+const MIN_PLANNING_SPEED_UPS: f64 = 1.0;
+
+/// The shared state of the stages of one airborne solve.
+pub(super) struct Planner<'a> {
+    pub(super) scene: &'a Scene,
+    pub(super) sim: &'a Simulation<'a>,
+    pub(super) settings: &'a SearchSettings,
+    /// The planning state after the fixed prefix.
+    pub(super) start: ModelState,
+    /// Game controls played before the plan, as they are: the seed's first frame when the start is at
+    /// rest (from rest every wish direction gains the same, and the planning model has no heading).
+    pub(super) prefix: Vec<Control>,
+    pub(super) fl: FrameLaw,
+    /// The finish line's normal, pointing the way the shortest path crosses it.
+    pub(super) progress_dir: Vec2,
+    pub(super) deadline: Option<Instant>,
+    pub(super) stats: SearchStats,
+    pub(super) timed_out: bool,
+}
+
+/// The airborne frame law of a scene.
+pub(super) fn frame_law(scene: &Scene) -> FrameLaw {
+    FrameLaw {
+        tau_s: scene.frame_time_s(),
+        law: air_law(&scene.vars),
+        side_key_speed: scene.vars.side_key_speed,
+    }
+}
+
+impl<'a> Planner<'a> {
+    /// The planner of `scene` starting from the `seed` run (its first frame becomes the prefix when the
+    /// start is at rest).
+    pub(super) fn new(
+        scene: &'a Scene,
+        sim: &'a Simulation<'a>,
+        settings: &'a SearchSettings,
+        bound: &LowerBound,
+        seed: &Trace,
+        deadline: Option<Instant>,
+    ) -> Self {
+        let prefix: Vec<Control> = if scene.start.speed() < MIN_PLANNING_SPEED_UPS {
+            seed.controls.iter().take(1).copied().collect()
+        } else {
+            Vec::new()
+        };
+        let (start_pos, start_vel) = match (prefix.len(), seed.frames.first()) {
+            (1, Some(first)) => (first.pos, first.vel),
+            _ => (scene.start.pos, scene.start.vel),
+        };
+        let start = ModelState {
+            pos: start_pos,
+            speed: start_vel.length(),
+            heading: if start_vel.length() > 0.0 {
+                start_vel.angle()
+            } else {
+                0.0
+            },
+        };
+        Planner {
+            scene,
+            sim,
+            settings,
+            start,
+            prefix,
+            fl: frame_law(scene),
+            progress_dir: finish_direction(scene, bound),
+            deadline,
+            stats: SearchStats::default(),
+            timed_out: false,
+        }
+    }
+
+    /// The SCP problem at wall `margin` (units), with relaxed or fixed sides, over planning steps of
+    /// `frames_per_knot` frames.
+    pub(super) fn problem(
+        &self,
+        margin: f64,
+        relaxed: bool,
+        frames_per_knot: u32,
+    ) -> ScpProblem<'a> {
+        ScpProblem {
+            start: self.start,
+            fl: self.fl,
+            corridor: self.sim.corridor(),
+            finish_a: self.scene.finish.a,
+            progress_dir: self.progress_dir,
+            margin,
+            slack_weight: self.settings.slack_weight,
+            wall_radius: self.settings.wall_radius_units,
+            relaxed,
+            frames_per_knot,
+        }
+    }
+
+    /// Runs one SCP stage of at most `max_iters` iterations from `controls`, counting its work; returns
+    /// the improved controls and whether it stopped at its iteration cap.
+    pub(super) fn stage(
+        &mut self,
+        problem: ScpProblem,
+        controls: Vec<FrameControl>,
+        max_iters: u64,
+    ) -> (Vec<FrameControl>, bool) {
+        scp_stage(
+            problem,
+            controls,
+            max_iters,
+            self.settings,
+            self.deadline,
+            &mut self.stats,
+            &mut self.timed_out,
+        )
+    }
+
+    /// Whether the deadline has passed (and notes it).
+    pub(super) fn out_of_time(&mut self) -> bool {
+        if self.deadline.is_some_and(|d| Instant::now() >= d) {
+            self.timed_out = true;
+        }
+        self.timed_out
+    }
+
+    /// The `seed` run in planning variables, after the prefix: the warm start of the relaxed stage. Each
+    /// frame's `c` is kept below the anglemod guard of the law's first case, where there is one.
+    pub(super) fn warm_start(&self, seed: &Trace) -> Vec<FrameControl> {
+        let fl = self.fl;
+        let mut vel = match self.prefix.len() {
+            0 => self.scene.start.vel,
+            _ => seed.frames.first().map_or(self.scene.start.vel, |f| f.vel),
+        };
+        let mut warm: Vec<FrameControl> = Vec::with_capacity(seed.controls.len());
+        for (c, rec) in seed
+            .controls
+            .iter()
+            .zip(&seed.frames)
+            .skip(self.prefix.len())
+        {
+            let mut u = frame_control_of(vel, c);
+            let v = vel.length();
+            if fl.c_plan_max(v) < fl.c_max(v) {
+                u.c = u.c.min(fl.c_plan_max(v));
+            }
+            warm.push(u);
+            vel = rec.vel;
+        }
+        warm
+    }
+}
+
+/// The finish line's unit normal pointing the way the shortest path crosses it.
+fn finish_direction(scene: &Scene, bound: &LowerBound) -> Vec2 {
+    let d = scene.finish.b - scene.finish.a;
+    let n = d.perp().normalized().unwrap_or(Vec2::new(1.0, 0.0));
+    let approach = match bound.path.len() {
+        0 | 1 => scene.finish.a - scene.start.pos,
+        k => bound.path[k - 1] - bound.path[k - 2],
+    };
+    if n.dot(approach) >= 0.0 {
+        n
+    } else {
+        -n
+    }
+}

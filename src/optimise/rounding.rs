@@ -1,0 +1,55 @@
+//! Rounding: from the relaxed plan's continuous sides to the game's `+-1` (docs/physics.md section 5: a
+//! frame's wish direction is on one side of the velocity or the other).
+
+use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState};
+
+/// How far ahead a heading error is weighed by the side rounding, seconds.
+pub(super) const ROUNDING_HORIZON_S: f64 = 0.05;
+/// Side sequences kept by the rounding's beam search.
+const ROUNDING_BEAM: usize = 64;
+
+/// Rounds relaxed sides to `+-1`: a beam search over side sequences that keeps the exact trajectory on the
+/// relaxed one. A sequence's cost adds, each frame, the squared position error and the squared distance
+/// its heading error would drift over a short horizon. Rounding frame by frame keeps the heading error
+/// bounded but not zero-mean where the relaxed sides saturate, and a steady heading error of a few
+/// hundredths of a radian drifts the path by tens of units.
+pub(super) fn round_sides(
+    start: &ModelState,
+    controls: &[FrameControl],
+    fl: &FrameLaw,
+) -> Vec<FrameControl> {
+    let relaxed = rollout(start, controls, fl);
+    let horizon_s = ROUNDING_HORIZON_S;
+    // Beam entries: (cost, state, index into the history of choices).
+    let mut history: Vec<(usize, f64)> = Vec::with_capacity(controls.len() * ROUNDING_BEAM * 2);
+    let mut beam: Vec<(f64, ModelState, usize)> = vec![(0.0, *start, usize::MAX)];
+    for (k, u) in controls.iter().enumerate() {
+        let target = relaxed[k];
+        let mut next: Vec<(f64, ModelState, usize)> = Vec::with_capacity(beam.len() * 2);
+        for &(cost, x, h) in &beam {
+            for sigma in [1.0, -1.0] {
+                let y = frame(&x, FrameControl { sigma, c: u.c }, fl, false).0;
+                let dpos = (y.pos - target.pos).length_squared();
+                let drift = (y.heading - target.heading) * y.speed * horizon_s;
+                history.push((h, sigma));
+                next.push((cost + dpos + drift * drift, y, history.len() - 1));
+            }
+        }
+        next.sort_by(|a, b| a.0.total_cmp(&b.0));
+        next.truncate(ROUNDING_BEAM);
+        beam = next;
+    }
+    let mut sides = Vec::with_capacity(controls.len());
+    let mut h = beam.first().map_or(usize::MAX, |b| b.2);
+    while h != usize::MAX {
+        let (parent, sigma) = history[h];
+        sides.push(sigma);
+        h = parent;
+    }
+    sides.reverse();
+    controls
+        .iter()
+        .zip(sides)
+        .map(|(u, sigma)| FrameControl { sigma, c: u.c })
+        .collect()
+}

@@ -1,0 +1,427 @@
+//! Sequential convex programming over one frame count: the planning problem argmin sees and the solver
+//! that steps it. For a frame count N it maximises how far past the finish line the player is after frame
+//! N, keeping every frame's straight move clear of the walls by a margin.
+//!
+//! Each SCP iteration is an argmin [`Solver`] step ([`ScpSolver`]): the frame model ([`super::model`]) is
+//! linearised around the current trajectory, Clarabel solves the convexified sub-step ([`super::qp`]), and
+//! the step is accepted only after exact re-simulation confirms it (actual against predicted improvement,
+//! a trust region in between). argmin's executor owns the loop, the iteration cap and the time limit.
+//! From the second iteration on, the sub-step also carries the curvature of the Lagrangian, weighted by
+//! the last sub-step's dynamics duals and convexified ([`super::lagrangian`]): a sequential quadratic
+//! program. Its model is right to second order, so its steps stay long along a line of hundreds of frames
+//! where a linear model's trust region would shrink to nothing.
+
+use super::lagrangian::{convexify, lagrangian_block, CurvatureBlock};
+use super::model::{knot, knot_hessian, rollout_knots, FrameControl, FrameLaw, ModelState};
+use super::qp::{self, SubProblem, SubStepStatus, WallRow};
+use super::search::{SearchSettings, SearchStats};
+use crate::geometry::{Corridor, Separation};
+use crate::physics::Vec2;
+use crate::scene::Scene;
+use argmin::core::{
+    CostFunction, Error as ArgminError, Executor, IterState, Problem, Solver, State,
+    TerminationReason, TerminationStatus, KV,
+};
+use std::time::{Duration, Instant};
+
+/// The problem argmin sees: the plan's parameters `(sigma_0, c_0, sigma_1, c_1, ...)` and, as cost, minus
+/// the merit `progress - weight * violation`.
+pub struct ScpProblem<'a> {
+    pub(super) start: ModelState,
+    pub(super) fl: FrameLaw,
+    pub(super) corridor: &'a Corridor,
+    pub(super) finish_a: Vec2,
+    pub(super) progress_dir: Vec2,
+    pub(super) margin: f64,
+    pub(super) slack_weight: f64,
+    pub(super) wall_radius: f64,
+    pub(super) relaxed: bool,
+    /// Frames per planning step: 1, or a coarse stage's knot ([`knot`]).
+    pub(super) frames_per_knot: u32,
+}
+
+/// The trajectory of a parameter vector with what the sub-problem needs.
+struct Linearised {
+    states: Vec<ModelState>,
+    jacobians: Vec<super::model::FrameJacobian>,
+    walls: Vec<WallRow>,
+    /// Per frame, the convexified Lagrangian block, when duals were given.
+    curvature: Option<Vec<CurvatureBlock>>,
+}
+
+fn unpack(p: &[f64]) -> Vec<FrameControl> {
+    p.chunks_exact(2)
+        .map(|u| FrameControl {
+            sigma: u[0],
+            c: u[1],
+        })
+        .collect()
+}
+
+fn pack(u: &[FrameControl]) -> Vec<f64> {
+    u.iter().flat_map(|f| [f.sigma, f.c]).collect()
+}
+
+impl ScpProblem<'_> {
+    fn progress(&self, p: Vec2) -> f64 {
+        self.progress_dir.dot(p - self.finish_a)
+    }
+
+    /// Merit of a trajectory: progress after the last frame less the weighted violations.
+    fn merit(&self, states: &[ModelState]) -> f64 {
+        let last = states.last().map_or(self.start.pos, |s| s.pos);
+        self.progress(last) - self.slack_weight * self.violation(states)
+    }
+
+    /// Total violation, units: how far the frames' moves come closer to a wall than the accepted
+    /// clearance, half the margin. The sub-problems ask for the whole margin, so the second-order error
+    /// of a step along a wall (the linearised dynamics are exact only to first order) stays inside the
+    /// other half instead of being charged at the slack weight: charging it stalls the trust region.
+    pub(super) fn violation(&self, states: &[ModelState]) -> f64 {
+        let accepted = MERIT_MARGIN_SHARE * self.margin;
+        let mut violation = 0.0;
+        let mut prev = self.start.pos;
+        for s in states {
+            violation +=
+                (accepted - self.corridor.move_clearance(prev, s.pos, self.wall_radius)).max(0.0);
+            prev = s.pos;
+        }
+        violation
+    }
+
+    /// The trajectory of `controls`, its Jacobians and wall rows, and with `duals` (one per frame, from
+    /// the last sub-problem) the convexified curvature of the Lagrangian ([`super::lagrangian`]).
+    fn linearise(&self, controls: &[FrameControl], duals: Option<&[[f64; 4]]>) -> Linearised {
+        let mut states = Vec::with_capacity(controls.len());
+        let mut jacobians = Vec::with_capacity(controls.len());
+        let duals = duals.filter(|z| z.len() == controls.len());
+        let mut curvature = duals.map(|_| Vec::with_capacity(controls.len()));
+        let mut x = self.start;
+        for (k, &u) in controls.iter().enumerate() {
+            let (next, j) = knot(&x, u, &self.fl, self.frames_per_knot, true);
+            if let Some(j) = j {
+                jacobians.push(j);
+            }
+            if let (Some(blocks), Some(z)) = (curvature.as_mut(), duals) {
+                let hessian = knot_hessian(&x, u, &self.fl, self.frames_per_knot);
+                let w = lagrangian_block(&hessian, &z[k]);
+                blocks.push(convexify(&w));
+            }
+            states.push(next);
+            x = next;
+        }
+        let mut walls = Vec::new();
+        let mut seps: Vec<Separation> = Vec::new();
+        let mut prev = self.start.pos;
+        for (k, s) in states.iter().enumerate() {
+            seps.clear();
+            self.corridor
+                .separations(prev, s.pos, self.wall_radius, None, &mut seps);
+            for sep in &seps {
+                walls.push(WallRow {
+                    frame: k,
+                    plane: sep.plane,
+                });
+                if k > 0 {
+                    walls.push(WallRow {
+                        frame: k - 1,
+                        plane: sep.plane,
+                    });
+                }
+            }
+            prev = s.pos;
+        }
+        Linearised {
+            states,
+            jacobians,
+            walls,
+            curvature,
+        }
+    }
+
+    /// Lowest `c` allowed at speed `v`: braking down to `cos theta = -0.95`.
+    fn c_min(&self, v: f64) -> f64 {
+        -0.95 * v
+    }
+}
+
+impl CostFunction for ScpProblem<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+
+    fn cost(&self, p: &Self::Param) -> std::result::Result<f64, ArgminError> {
+        let states = rollout_knots(&self.start, &unpack(p), &self.fl, self.frames_per_knot);
+        let m = self.merit(&states);
+        if m.is_finite() {
+            Ok(-m)
+        } else {
+            Err(ArgminError::msg("the plan's trajectory is not finite"))
+        }
+    }
+}
+
+type ScpState = IterState<Vec<f64>, (), (), (), (), f64>;
+
+/// One SCP iteration per argmin iteration: linearise, solve the Clarabel sub-problem, accept the step
+/// only if exact re-simulation confirms enough of the predicted gain.
+pub struct ScpSolver {
+    trust: f64,
+    sigma_trust: f64,
+    c_trust_ups: f64,
+    min_trust: f64,
+    tol: f64,
+    converged: bool,
+    stats: SearchStats,
+    /// Dynamics duals of the last solved sub-problem, per frame: the curvature weights.
+    duals: Option<Vec<[f64; 4]>>,
+}
+
+impl ScpSolver {
+    fn new(tol: f64) -> Self {
+        ScpSolver {
+            trust: 1.0,
+            sigma_trust: 0.1,
+            c_trust_ups: 5.0,
+            min_trust: 1e-7,
+            tol,
+            converged: false,
+            stats: SearchStats::default(),
+            duals: None,
+        }
+    }
+}
+
+/// Total wall violation, units, up to which a plan counts as clear (rounding of the clearance sums).
+pub(super) const CLEAN_VIOLATION_UNITS: f64 = 1e-9;
+
+/// Within this of the kink `L - gamma1`, ups, a frame's `c` counts as on it.
+const KINK_TOL_UPS: f64 = 1e-9;
+
+/// Share of the wall margin a plan must keep to count as clear (see [`ScpProblem::violation`]).
+const MERIT_MARGIN_SHARE: f64 = 0.5;
+
+/// Least share of the predicted gain a step must deliver to be accepted.
+const ACCEPT_RATIO: f64 = 0.1;
+
+impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
+    fn name(&self) -> &str {
+        "scp-clarabel"
+    }
+
+    fn init(
+        &mut self,
+        problem: &mut Problem<ScpProblem<'a>>,
+        state: ScpState,
+    ) -> std::result::Result<(ScpState, Option<KV>), ArgminError> {
+        let param = state
+            .get_param()
+            .cloned()
+            .ok_or_else(|| ArgminError::msg("no start plan"))?;
+        let cost = problem.cost(&param)?;
+        Ok((state.cost(cost), None))
+    }
+
+    fn next_iter(
+        &mut self,
+        problem: &mut Problem<ScpProblem<'a>>,
+        state: ScpState,
+    ) -> std::result::Result<(ScpState, Option<KV>), ArgminError> {
+        let param = state
+            .get_param()
+            .cloned()
+            .ok_or_else(|| ArgminError::msg("no plan"))?;
+        let cost = state.get_cost();
+        let controls = unpack(&param);
+        let (trust, sigma_trust, c_trust) = (self.trust, self.sigma_trust, self.c_trust_ups);
+        let upper_at_kink = state.get_iter() % 2 == 0;
+        let duals = self.duals.take();
+        let step = problem.problem("linearise-and-solve", |pr| {
+            // Each frame stays on its piece of mu = min(gamma1, L - c) within a step, so the linearisation
+            // is exact to first order; a frame on the kink tries the upper piece (mu = L - c) on even
+            // iterations and the lower (mu = gamma1) on odd ones.
+            let kink = pr.fl.kink();
+            let at_kink = |c: f64| (c - kink).abs() <= KINK_TOL_UPS;
+            let lin_controls: Vec<FrameControl> = controls
+                .iter()
+                .map(|u| {
+                    if at_kink(u.c) {
+                        let c = if upper_at_kink {
+                            kink + KINK_TOL_UPS
+                        } else {
+                            kink - KINK_TOL_UPS
+                        };
+                        FrameControl { c, ..*u }
+                    } else {
+                        *u
+                    }
+                })
+                .collect();
+            let lin = pr.linearise(&lin_controls, duals.as_deref());
+            let mut sigma_range = Vec::with_capacity(controls.len());
+            let mut c_range = Vec::with_capacity(controls.len());
+            let mut speed = pr.start.speed;
+            for (k, u) in lin_controls.iter().enumerate() {
+                let ds = trust * sigma_trust;
+                sigma_range.push(if pr.relaxed {
+                    (ds.min(1.0 + u.sigma), ds.min(1.0 - u.sigma))
+                } else {
+                    (0.0, 0.0)
+                });
+                let dc = trust * c_trust;
+                let (mut lo, mut hi) = (
+                    dc.min(u.c - pr.c_min(speed)).max(0.0),
+                    dc.min(pr.fl.c_plan_max(speed) - u.c).max(0.0),
+                );
+                if u.c > kink {
+                    lo = lo.min(u.c - kink);
+                } else {
+                    hi = hi.min(kink - u.c);
+                }
+                c_range.push((lo, hi));
+                speed = lin.states[k].speed;
+            }
+            let positions: Vec<Vec2> = lin.states.iter().map(|s| s.pos).collect();
+            let sub = SubProblem {
+                jacobians: &lin.jacobians,
+                positions: &positions,
+                walls: &lin.walls,
+                margin: pr.margin,
+                accepted_clearance: MERIT_MARGIN_SHARE * pr.margin,
+                slack_weight: pr.slack_weight,
+                progress_dir: pr.progress_dir,
+                sigma_range: &sigma_range,
+                c_range: &c_range,
+                curvature: lin.curvature.as_deref(),
+            };
+            Ok(qp::solve(&sub))
+        })?;
+        self.stats.iterations += 1;
+        self.stats.subproblems += 1;
+        let du = match step.status {
+            SubStepStatus::Solved { .. } => {
+                self.duals = Some(step.dynamics_duals);
+                step.du
+            }
+            SubStepStatus::Failed(_) => {
+                self.stats.subproblem_failures += 1;
+                self.trust *= 0.25;
+                return Ok((state, None));
+            }
+        };
+        // No gain in the merit by the model: converged. The prediction can be negative: the sub-problem
+        // also asks moves inside the wall margin back out to it, which the merit (it counts only what is
+        // closer than the accepted clearance) does not pay for.
+        if step.predicted <= self.tol {
+            self.converged = true;
+            return Ok((state, None));
+        }
+        let candidate: Vec<f64> = controls
+            .iter()
+            .zip(&du)
+            .flat_map(|(u, d)| [(u.sigma + d.0).clamp(-1.0, 1.0), u.c + d.1])
+            .collect();
+        // A plan whose trajectory is not finite is simply worse than any finite one.
+        let new_cost = problem.cost(&candidate).unwrap_or(f64::INFINITY);
+        let actual = cost - new_cost;
+        let ratio = actual / step.predicted;
+        if actual > 0.0 && ratio >= ACCEPT_RATIO {
+            if ratio > 0.75 {
+                self.trust = (self.trust * 2.0).min(4.0);
+            } else if ratio < 0.25 {
+                self.trust *= 0.5;
+            }
+            Ok((state.param(candidate).cost(new_cost), None))
+        } else {
+            self.stats.rejected_steps += 1;
+            self.trust *= 0.3;
+            Ok((state, None))
+        }
+    }
+
+    fn terminate(&mut self, _state: &ScpState) -> TerminationStatus {
+        if self.converged || self.trust < self.min_trust {
+            TerminationStatus::Terminated(TerminationReason::SolverConverged)
+        } else {
+            TerminationStatus::NotTerminated
+        }
+    }
+}
+
+/// Runs SCP on `controls`; returns the improved controls, whether the time limit stopped it, whether it
+/// stopped at the iteration cap, and the work done.
+pub(super) fn run_scp(
+    problem: ScpProblem,
+    controls: Vec<FrameControl>,
+    max_iters: u64,
+    tol: f64,
+    deadline: Option<Instant>,
+) -> (Vec<FrameControl>, bool, bool, SearchStats) {
+    let x0 = pack(&controls);
+    let mut exec = Executor::new(problem, ScpSolver::new(tol))
+        .configure(|s| s.param(x0.clone()).max_iters(max_iters));
+    if let Some(d) = deadline {
+        exec = exec.timeout(
+            d.saturating_duration_since(Instant::now())
+                .max(Duration::from_millis(1)),
+        );
+    }
+    match exec.run() {
+        Ok(res) => {
+            let reason = res.state().get_termination_reason();
+            let timed_out = matches!(reason, Some(TerminationReason::Timeout));
+            let capped = matches!(reason, Some(TerminationReason::MaxItersReached));
+            let best = res
+                .state()
+                .get_best_param()
+                .or(res.state().get_param())
+                .cloned()
+                .unwrap_or(x0);
+            // The solver's own counts (sub-problems, failures, rejections) with argmin's iterations.
+            let stats = SearchStats {
+                iterations: res.state().get_iter(),
+                ..res.solver.stats
+            };
+            (unpack(&best), timed_out, capped, stats)
+        }
+        Err(_) => (controls, false, false, SearchStats::default()),
+    }
+}
+
+/// One SCP stage: runs it, adds its work to `stats`, notes a timeout; returns the improved controls and
+/// whether the stage stopped at its iteration cap (still improving) rather than converged.
+pub(super) fn scp_stage(
+    problem: ScpProblem,
+    controls: Vec<FrameControl>,
+    max_iters: u64,
+    settings: &SearchSettings,
+    deadline: Option<Instant>,
+    stats: &mut SearchStats,
+    timed_out: &mut bool,
+) -> (Vec<FrameControl>, bool) {
+    let (c, t, capped, s) = run_scp(
+        problem,
+        controls,
+        max_iters,
+        settings.tol_progress_units,
+        deadline,
+    );
+    stats.add(&s);
+    *timed_out |= t;
+    (c, capped)
+}
+
+/// The first frame (1-based) whose move crosses the finish line, in the model.
+pub(super) fn model_crossing(
+    start: &ModelState,
+    states: &[ModelState],
+    scene: &Scene,
+) -> Option<usize> {
+    let mut prev = start.pos;
+    for (k, s) in states.iter().enumerate() {
+        if scene.finish.crossing_fraction(prev, s.pos).is_some() {
+            return Some(k + 1);
+        }
+        prev = s.pos;
+    }
+    None
+}
