@@ -113,6 +113,13 @@ pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
             "time": o.greedy.crossing.map(|c| c.time),
             "feasible": o.greedy.feasible(),
             "controller": o.greedy.controller,
+            "guide": o.greedy_guide,
+        },
+        "relaxed": o.relaxed,
+        "rounding_loss_frames": rounding_loss_frames(scene, o),
+        "gap_to_relaxed": match (crossing, o.relaxed) {
+            (Some(c), Some(r)) => Some((c.time - r.time) / r.time.max(f64::MIN_POSITIVE)),
+            _ => None,
         },
         "lower_bound": {
             "frames": lb.frames,
@@ -129,6 +136,13 @@ pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
             {"label": "optimised", "controls": o.controls},
         ],
     })
+}
+
+/// The plan's crossing time less the relaxed optimum's, in frames: what rounding the sides to `+-1`, the
+/// wall margin and the anglemod steps cost.
+pub fn rounding_loss_frames(scene: &Scene, o: &Outcome) -> Option<f64> {
+    let (c, r) = (o.trace.crossing?, o.relaxed?);
+    Some((c.time - r.time) / scene.frame_time_s())
 }
 
 fn summary_text(scene: &Scene, o: &Outcome) -> String {
@@ -168,9 +182,22 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         }
     ));
     s.push_str(&format!(
+        "greedy guide:    {}\n",
+        o.greedy_guide
+    ));
+    s.push_str(&format!(
         "lower bound:     {:.6} s (frame {})\n",
         lb.time, lb.frames
     ));
+    if let Some(r) = o.relaxed {
+        s.push_str(&format!(
+            "relaxed optimum: {:.6} s (frame {}; a local optimum: {} of {} starts reached the line, spread {:.6} s)\n",
+            r.time, r.frames, r.reached, r.starts, r.spread
+        ));
+    }
+    if let Some(loss) = rounding_loss_frames(scene, o) {
+        s.push_str(&format!("rounding loss:   {loss:.3} frames\n"));
+    }
     if let Some(c) = o.trace.crossing {
         s.push_str(&format!(
             "gap to bound:    {:.3}%\n",

@@ -1,26 +1,88 @@
 //! Seed and baseline: the greedy strafer's best runs, which the search starts from and which its plan is
 //! compared with.
+//!
+//! The baseline is the strongest greedy strafer we know how to run: the look-ahead strafer (maximum
+//! acceleration every frame, docs/physics.md section 6, steering only by its side) along each of several
+//! guides: the corridor's shortest path kept 0 to 40 units off the walls and
+//! the centre line (the guide kept as far off the walls as the corridor allows), every look-ahead, then
+//! the same with speed caps from the radius-speed relation (section 9). The fastest valid run is the
+//! baseline, and which guide gave it is reported.
 
 use super::verify::time_of;
 use super::LowerBound;
 use crate::geometry::{Corridor, HULL_HALF_WIDTH_UNITS};
 use crate::physics::curvature::{bend_arc_radius, speed_for_radius};
+use crate::physics::Vec2;
 use crate::scene::Scene;
-use crate::sim::controllers::{best_capped_greedy, Greedy, GREEDY_LOOKAHEADS_UNITS};
+use crate::sim::controllers::{Greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{Simulation, Trace};
 
-/// Extra clearances of the guide paths, units, tried in turn when the best greedy run is not clean.
-const GUIDE_CLEARANCES_UNITS: [f64; 5] = [0.0, 2.0, 4.0, 8.0, 12.0];
+/// Extra clearances of the guide paths off the walls, units (beyond the hull's half width).
+const GUIDE_CLEARANCES_UNITS: [f64; 7] = [0.0, 4.0, 8.0, 16.0, 24.0, 32.0, 40.0];
+
+/// The centre line's clearance is found to within this, units.
+const CENTRE_LINE_TOL_UNITS: f64 = 0.5;
+
+/// The centre line is searched for up to this clearance, units (a corridor 2 x 1024 units wide).
+const CENTRE_LINE_MAX_UNITS: f64 = 1024.0;
 
 /// Corridor widths, units, whose bend arcs give the greedy strafer's speed caps (see [`corner_caps`]).
 const CAP_WIDTHS_UNITS: [f64; 5] = [16.0, 32.0, 64.0, 128.0, 256.0];
 
-/// The baseline and the seed of a solve.
+/// The distinct clean runs kept as starts of the relaxed problem, at most.
+pub(super) const MAX_STARTS: usize = 4;
+
+/// A guide of the greedy strafer and its settings.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct GreedyGuide {
+    /// How far the guide path keeps off the walls beyond the hull's half width, units.
+    pub clearance_units: f64,
+    /// Whether this is the centre line: the guide kept as far off the walls as the corridor allows.
+    pub centre_line: bool,
+    /// The strafer's look-ahead along the guide, units.
+    pub lookahead_units: f64,
+    /// The speed the strafer holds once reached, ups, if capped.
+    pub speed_cap_ups: Option<f64>,
+}
+
+impl std::fmt::Display for GreedyGuide {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.centre_line {
+            write!(f, "centre line ({:.1} units off the walls)", self.clearance_units)?;
+        } else {
+            write!(f, "shortest path {:.1} units off the walls", self.clearance_units)?;
+        }
+        write!(f, ", look-ahead {:.1} units", self.lookahead_units)?;
+        if let Some(cap) = self.speed_cap_ups {
+            write!(f, ", speed cap {cap:.1} ups")?;
+        }
+        Ok(())
+    }
+}
+
+/// A run of the greedy strafer and the guide it followed.
+#[derive(Clone, Debug)]
+pub(super) struct GuideRun {
+    pub(super) guide: GreedyGuide,
+    pub(super) trace: Trace,
+}
+
+/// The baseline and the seeds of a solve.
 pub(super) struct Baseline {
-    /// The fastest valid greedy run (infinite time when none is valid): the run the plan is compared with.
-    pub(super) greedy: Trace,
-    /// The run the search starts from: a valid run that touches no wall, where there is one.
-    pub(super) seed: Trace,
+    /// The fastest valid greedy run (an invalid one when none is valid): the run the plan is compared
+    /// with.
+    pub(super) greedy: GuideRun,
+    /// Clean runs (valid, finished, no wall contact) from distinct guides, fastest first: the search
+    /// starts from the first; the others are further starts of the relaxed problem. Empty when no run is
+    /// clean.
+    pub(super) clean: Vec<GuideRun>,
+}
+
+impl Baseline {
+    /// The run the search starts from: the fastest clean run, else the baseline.
+    pub(super) fn seed(&self) -> &Trace {
+        self.clean.first().map_or(&self.greedy.trace, |r| &r.trace)
+    }
 }
 
 /// Speed caps from the radius-speed relation (docs/physics.md section 9): the speeds whose measured turn
@@ -33,69 +95,159 @@ fn corner_caps(scene: &Scene) -> Vec<f64> {
         .collect()
 }
 
-/// The baseline and seed of `scene`. The search's start is the greedy run if it is valid and touches no
-/// wall (the planning model has no collisions: after a contact the model and the game part ways), else a
-/// run along a centred guide; the baseline is the faster valid run of the two.
+/// A guide path: the shortest path of a body `clearance_units` wider than the hull on either side.
+struct GuidePath {
+    clearance_units: f64,
+    centre_line: bool,
+    path: Vec<Vec2>,
+}
+
+/// The guide paths of `scene`: the shortest path (the lower bound's) and the paths kept each of
+/// [`GUIDE_CLEARANCES_UNITS`] off the walls where the corridor has room, then the centre line.
+fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
+    let mut guides = vec![GuidePath {
+        clearance_units: 0.0,
+        centre_line: false,
+        path: bound.path.clone(),
+    }];
+    for &extra in &GUIDE_CLEARANCES_UNITS[1..] {
+        match clear_path(scene, extra) {
+            Some(path) => guides.push(GuidePath {
+                clearance_units: extra,
+                centre_line: false,
+                path,
+            }),
+            None => break,
+        }
+    }
+    if let Some((extra, path)) = centre_line(scene) {
+        let known = guides
+            .iter()
+            .any(|g| (g.clearance_units - extra).abs() < 2.0 * CENTRE_LINE_TOL_UNITS);
+        if !known {
+            guides.push(GuidePath {
+                clearance_units: extra,
+                centre_line: true,
+                path,
+            });
+        }
+    }
+    guides
+}
+
+/// The shortest path kept `extra_units` further off every wall than the hull needs, if there is one.
+fn clear_path(scene: &Scene, extra_units: f64) -> Option<Vec<Vec2>> {
+    let corridor = Corridor::with_half_width(&scene.walls, HULL_HALF_WIDTH_UNITS + extra_units).ok()?;
+    corridor
+        .shortest_path(scene.start.pos, (scene.finish.a, scene.finish.b))
+        .map(|(_, path)| path)
+}
+
+/// The centre line: the path kept as far off the walls as the corridor allows (bisection on the
+/// clearance).
+fn centre_line(scene: &Scene) -> Option<(f64, Vec<Vec2>)> {
+    let (mut lo, mut hi) = (0.0, CENTRE_LINE_MAX_UNITS);
+    let mut best: Option<(f64, Vec<Vec2>)> = None;
+    while hi - lo > CENTRE_LINE_TOL_UNITS {
+        let mid = 0.5 * (lo + hi);
+        match clear_path(scene, mid) {
+            Some(path) => {
+                best = Some((mid, path));
+                lo = mid;
+            }
+            None => hi = mid,
+        }
+    }
+    best
+}
+
+/// The baseline and seeds of `scene` (see the module documentation). The planning model has no
+/// collisions (after a contact the model and the game part ways), so the seeds are clean runs.
 pub(super) fn baseline(sim: &Simulation, scene: &Scene, bound: &LowerBound) -> Baseline {
-    let air_only = scene.effects.is_air_only();
-    let caps = if air_only {
+    let guides = guide_paths(scene, bound);
+    let caps = if scene.effects.is_air_only() {
         corner_caps(scene)
     } else {
         Vec::new()
     };
-    let (greedy, _, _) = best_capped_greedy(sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS, &caps);
-    let seed = if air_only && !clean(&greedy) {
-        centred_greedy(sim, scene, &caps)
-    } else {
-        None
+    // Per guide path and cap, the fastest valid run and the fastest clean run.
+    let mut valid: Option<GuideRun> = None;
+    let mut fallback: Option<((u8, f64), GuideRun)> = None;
+    let mut clean: Vec<GuideRun> = Vec::new();
+    for cap in std::iter::once(None).chain(caps.iter().copied().map(Some)) {
+        // Capped runs along the shortest path and the widest guide only: the caps are for corners the
+        // uncapped strafer overshoots, and every guide in between would multiply the runs.
+        let last = guides.len() - 1;
+        for (i, g) in guides.iter().enumerate() {
+            if cap.is_some() && i != 0 && i != last {
+                continue;
+            }
+            let mut best_clean: Option<GuideRun> = None;
+            for &la in &GREEDY_LOOKAHEADS_UNITS {
+                let strafer = Greedy::new(g.path.clone(), la);
+                let trace = sim.run(&mut match cap {
+                    Some(cap) => strafer.with_speed_cap(cap),
+                    None => strafer,
+                });
+                let run = GuideRun {
+                    guide: GreedyGuide {
+                        clearance_units: g.clearance_units,
+                        centre_line: g.centre_line,
+                        lookahead_units: la,
+                        speed_cap_ups: cap,
+                    },
+                    trace,
+                };
+                let t = time_of(&run.trace);
+                if is_clean(&run.trace) && best_clean.as_ref().is_none_or(|b| t < time_of(&b.trace))
+                {
+                    best_clean = Some(run.clone());
+                }
+                if t.is_finite() {
+                    if valid.as_ref().is_none_or(|b| t < time_of(&b.trace)) {
+                        valid = Some(run);
+                    }
+                } else if valid.is_none() {
+                    let r = rank(&run.trace, &g.path);
+                    if fallback.as_ref().is_none_or(|(b, _)| r < *b) {
+                        fallback = Some((r, run));
+                    }
+                }
+            }
+            clean.extend(best_clean);
+        }
+    }
+    clean.sort_by(|a, b| time_of(&a.trace).total_cmp(&time_of(&b.trace)));
+    clean.truncate(MAX_STARTS);
+    let greedy = match (valid, fallback) {
+        (Some(v), _) => v,
+        (None, Some((_, f))) => f,
+        (None, None) => GuideRun {
+            guide: GreedyGuide {
+                clearance_units: 0.0,
+                centre_line: false,
+                lookahead_units: GREEDY_LOOKAHEADS_UNITS[0],
+                speed_cap_ups: None,
+            },
+            trace: sim.run(&mut Greedy::new(bound.path.clone(), GREEDY_LOOKAHEADS_UNITS[0])),
+        },
     };
-    let greedy = match &seed {
-        Some(s) if time_of(s) <= time_of(&greedy) => s.clone(),
-        _ => greedy,
-    };
-    let seed = seed.unwrap_or_else(|| greedy.clone());
-    Baseline { greedy, seed }
+    Baseline { greedy, clean }
 }
 
 /// A run the planning model can follow: valid, finished, and touching no wall.
-fn clean(t: &Trace) -> bool {
+fn is_clean(t: &Trace) -> bool {
     t.feasible() && t.crossing.is_some() && t.collisions() == 0
 }
 
-/// The fastest clean run of the greedy strafer (every look-ahead, uncapped and with each speed cap)
-/// along a guide: the shortest path of a body wider than the hull by each of [`GUIDE_CLEARANCES_UNITS`]
-/// on either side in turn, so the guide keeps that far from every wall; the first guide with a clean run
-/// gives it. Needed where the best greedy run is not clean: in a corridor only a little wider than the
-/// hull the plain guide runs along the grown inner corner and the greedy strafer, steering by its side
-/// only, weaves across it; between solid walls the fastest greedy runs slide along them, which the
-/// planning model (no collisions) cannot follow. `None` if no run is clean.
-fn centred_greedy(sim: &Simulation, scene: &Scene, caps: &[f64]) -> Option<Trace> {
-    for extra in GUIDE_CLEARANCES_UNITS {
-        let Ok(corridor) = Corridor::with_half_width(&scene.walls, HULL_HALF_WIDTH_UNITS + extra)
-        else {
-            continue;
-        };
-        let Some((_, path)) =
-            corridor.shortest_path(scene.start.pos, (scene.finish.a, scene.finish.b))
-        else {
-            continue;
-        };
-        let mut best: Option<Trace> = None;
-        for cap in std::iter::once(None).chain(caps.iter().copied().map(Some)) {
-            for &la in &GREEDY_LOOKAHEADS_UNITS {
-                let greedy = Greedy::new(path.clone(), la);
-                let t = sim.run(&mut match cap {
-                    Some(cap) => greedy.with_speed_cap(cap),
-                    None => greedy,
-                });
-                if clean(&t) && best.as_ref().is_none_or(|b| time_of(&t) < time_of(b)) {
-                    best = Some(t);
-                }
-            }
-        }
-        if best.is_some() {
-            return best;
+/// Sort key of an invalid run: crossings first by time, then the rest by how far along the guide path
+/// they ended (further is better).
+fn rank(t: &Trace, path: &[Vec2]) -> (u8, f64) {
+    match t.crossing {
+        Some(c) => (1, c.time),
+        None => {
+            let end = t.frames.last().map_or(t.start.pos, |f| f.pos);
+            (2, -Greedy::new(path.to_vec(), 0.0).project(end))
         }
     }
-    None
 }

@@ -17,7 +17,9 @@ pub mod search;
 pub mod substep;
 mod verify;
 
+pub use baseline::GreedyGuide;
 pub use bound::{lower_bound, LowerBound};
+pub use relaxed::RelaxedCertificate;
 pub use search::{
     solve, solve_with_progress, Outcome, Progress, Quality, SearchSettings, SearchStatus,
 };

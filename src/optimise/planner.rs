@@ -1,14 +1,14 @@
 //! What the stages of an airborne solve share: where planning starts, the frame law, the corridor, the
 //! direction of progress, the settings, the deadline and the work done so far.
 
-use super::model::{frame_control_of, FrameControl, FrameLaw, ModelState};
+use super::model::{frame_control_of, rollout, FrameControl, FrameLaw, ModelState};
 use super::scp::{scp_stage, ScpProblem};
 use super::search::{SearchSettings, SearchStats};
 use super::LowerBound;
 use crate::physics::curvature::air_law;
 use crate::physics::{Control, Vec2};
 use crate::scene::Scene;
-use crate::sim::{Simulation, Trace};
+use crate::sim::{Crossing, Simulation, Trace};
 use std::time::Instant;
 
 /// Below this start speed, ups, the planning model has no heading to work from: the seed's first frame is
@@ -104,6 +104,7 @@ impl<'a> Planner<'a> {
             wall_radius: self.settings.wall_radius_units,
             relaxed,
             frames_per_knot,
+            anglemod_guard: true,
         }
     }
 
@@ -124,6 +125,22 @@ impl<'a> Planner<'a> {
             &mut self.stats,
             &mut self.timed_out,
         )
+    }
+
+    /// The time of a planned run of `controls` after the prefix: the fractional crossing time of the
+    /// model's trajectory, seconds, and the crossing frame (counting the prefix); `None` if it does not
+    /// cross the line.
+    pub(super) fn crossing_of(&self, controls: &[FrameControl]) -> Option<Crossing> {
+        let states = rollout(&self.start, controls, &self.fl);
+        let mut prev = self.start.pos;
+        for (k, s) in states.iter().enumerate() {
+            if let Some(f) = self.scene.finish.crossing_fraction(prev, s.pos) {
+                let frame = (self.prefix.len() + k + 1) as u64;
+                return Some(Crossing::new(frame, f, self.fl.tau_s));
+            }
+            prev = s.pos;
+        }
+        None
     }
 
     /// Whether the deadline has passed (and notes it).

@@ -6,7 +6,7 @@
 
 use super::model::{rollout_knots, FrameControl};
 use super::planner::Planner;
-use super::scp::model_crossing;
+use super::scp::{model_crossing, ScpProblem};
 use super::search::Progress;
 
 /// Times a relaxed stage that stopped at its iteration cap without a clean crossing is continued at the
@@ -18,6 +18,34 @@ const COARSE_KNOTS: usize = 400;
 
 /// Times a frame count that the line cannot be reached in is grown before the search gives up.
 const MAX_GROW_TRIES: usize = 3;
+
+/// Which relaxed problem: the wall margin and whether `c` keeps under the anglemod guard.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Relaxation {
+    /// Wall margin, units.
+    pub(super) margin_units: f64,
+    /// See [`super::scp::ScpProblem::anglemod_guard`].
+    pub(super) anglemod_guard: bool,
+}
+
+impl Relaxation {
+    /// The relaxed problem the plan is rounded from, at `margin_units`, under the anglemod guard.
+    pub(super) fn planning(margin_units: f64) -> Self {
+        Relaxation {
+            margin_units,
+            anglemod_guard: true,
+        }
+    }
+
+    /// The problem of the certificate: zero margin and no guard, so every exact plan is one of its
+    /// points.
+    pub(super) fn certificate() -> Self {
+        Relaxation {
+            margin_units: 0.0,
+            anglemod_guard: false,
+        }
+    }
+}
 
 /// Frames per knot of the coarse stage for a run of about `frames` frames: knots of several frames
 /// once the run is long enough that about [`COARSE_KNOTS`] knots cover it, else 1 (no coarse stage).
@@ -36,7 +64,7 @@ pub(super) fn relaxed_plan(
     mut controls: Vec<FrameControl>,
     mut n: usize,
     lo: usize,
-    margin: f64,
+    relaxation: Relaxation,
 ) -> Option<Vec<FrameControl>> {
     let knot_frames = coarse_knot_frames(n);
     if knot_frames > 1 {
@@ -62,7 +90,10 @@ pub(super) fn relaxed_plan(
             knots,
             count,
             lo / m,
-            margin + sagitta,
+            Relaxation {
+                margin_units: relaxation.margin_units + sagitta,
+                ..relaxation
+            },
             knot_frames,
         ) {
             controls = plan
@@ -72,22 +103,23 @@ pub(super) fn relaxed_plan(
             n = controls.len();
         }
     }
-    count_search(planner, progress, controls, n, lo, margin, 1)
+    count_search(planner, progress, controls, n, lo, relaxation, 1)
 }
 
 /// The search over the number of planning steps (frames or knots of `frames_per_knot` frames): SCP at `n`
 /// steps from `controls`, then at one step fewer than the plan's crossing, until the line is no longer
 /// reached (or `lo` steps, below which the bound says it cannot be); more steps if the first count does
 /// not reach it. Returns the best clean plan, cut at its crossing step.
-pub(super) fn count_search(
-    planner: &mut Planner,
+pub(super) fn count_search<'a>(
+    planner: &mut Planner<'a>,
     progress: &mut dyn FnMut(Progress),
     mut controls: Vec<FrameControl>,
     mut n: usize,
     lo: usize,
-    margin: f64,
+    relaxation: Relaxation,
     frames_per_knot: u32,
 ) -> Option<Vec<FrameControl>> {
+    let problem = |p: &Planner<'a>| relaxed_problem(p, relaxation, frames_per_knot);
     let fl = planner.fl;
     let relaxed_iters = planner.settings.relaxed_iters;
     let mut best: Option<Vec<FrameControl>> = None;
@@ -105,13 +137,11 @@ pub(super) fn count_search(
             },
         );
         planner.stats.frame_counts_tried += 1;
-        let pr = planner.problem(margin, true, frames_per_knot);
+        let pr = problem(planner);
         let (c, capped) = planner.stage(pr, controls.clone(), relaxed_iters);
         let states = rollout_knots(&planner.start, &c, &fl, frames_per_knot);
         let reached = model_crossing(&planner.start, &states, planner.scene);
-        let clean = planner
-            .problem(margin, true, frames_per_knot)
-            .violation(&states)
+        let clean = problem(planner).violation(&states)
             <= super::scp::CLEAN_VIOLATION_UNITS;
         let per = frames_per_knot as usize;
         progress(Progress::FrameCount {
@@ -148,4 +178,96 @@ pub(super) fn count_search(
         }
     }
     best
+}
+
+/// The SCP problem of `relaxation` over planning steps of `frames_per_knot` frames.
+fn relaxed_problem<'a>(
+    planner: &Planner<'a>,
+    relaxation: Relaxation,
+    frames_per_knot: u32,
+) -> ScpProblem<'a> {
+    ScpProblem {
+        anglemod_guard: relaxation.anglemod_guard,
+        ..planner.problem(relaxation.margin_units, true, frames_per_knot)
+    }
+}
+
+/// The relaxed optimum as a certificate: the relaxed problem at zero wall margin and without the anglemod
+/// guard, whose feasible set holds every exact plan, solved from several starts. Each start ends in a
+/// local optimum (the problem is not convex), so this is not a proof of a bound: the spread of the
+/// optimum over the starts is the evidence of how far from global it may be.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct RelaxedCertificate {
+    /// The frame in which the fastest relaxed plan crosses the line.
+    pub frames: u64,
+    /// Its fractional crossing time, seconds.
+    pub time: f64,
+    /// Starts tried.
+    pub starts: usize,
+    /// Starts whose relaxed plan reached the line.
+    pub reached: usize,
+    /// The slowest less the fastest crossing time over the starts that reached the line, seconds.
+    pub spread: f64,
+}
+
+/// The certificate's fastest relaxed plan and the start it came from.
+pub(super) struct CertifiedPlan {
+    pub(super) controls: Vec<FrameControl>,
+    pub(super) start_index: usize,
+}
+
+/// The relaxed certificate from `starts` (warm starts, each cut near its crossing), tried in order while
+/// time is left; no plan crosses before frame `lo`. The first start is the planning stage's relaxed plan
+/// and is refined frame by frame; the others go coarse to fine. Returns the certificate and its fastest
+/// plan.
+pub(super) fn certify(
+    planner: &mut Planner,
+    progress: &mut dyn FnMut(Progress),
+    starts: Vec<Vec<FrameControl>>,
+    lo: usize,
+) -> Option<(RelaxedCertificate, CertifiedPlan)> {
+    let mut tried = 0;
+    let mut times: Vec<f64> = Vec::new();
+    let mut best: Option<(crate::sim::Crossing, CertifiedPlan)> = None;
+    for (i, start) in starts.into_iter().enumerate() {
+        if planner.out_of_time() {
+            break;
+        }
+        tried += 1;
+        let n = start.len();
+        let relaxation = Relaxation::certificate();
+        let plan = if i == 0 {
+            count_search(planner, progress, start, n, lo, relaxation, 1)
+        } else {
+            relaxed_plan(planner, progress, start, n, lo, relaxation)
+        };
+        let Some(plan) = plan else {
+            continue;
+        };
+        let Some(crossing) = planner.crossing_of(&plan) else {
+            continue;
+        };
+        times.push(crossing.time);
+        if best.as_ref().is_none_or(|(b, _)| crossing.time < b.time) {
+            best = Some((
+                crossing,
+                CertifiedPlan {
+                    controls: plan,
+                    start_index: i,
+                },
+            ));
+        }
+    }
+    let (crossing, plan) = best?;
+    let slowest = times.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    Some((
+        RelaxedCertificate {
+            frames: crossing.frames,
+            time: crossing.time,
+            starts: tried,
+            reached: times.len(),
+            spread: slowest - crossing.time,
+        },
+        plan,
+    ))
 }

@@ -38,6 +38,9 @@ pub struct ScpProblem<'a> {
     pub(super) relaxed: bool,
     /// Frames per planning step: 1, or a coarse stage's knot ([`knot`]).
     pub(super) frames_per_knot: u32,
+    /// Whether `c` stays under the anglemod guard of the law's first case ([`FrameLaw::c_plan_max`]);
+    /// off for the relaxed certificate, whose feasible set must hold every exact plan.
+    pub(super) anglemod_guard: bool,
 }
 
 /// The trajectory of a parameter vector with what the sub-problem needs.
@@ -136,6 +139,15 @@ impl ScpProblem<'_> {
             jacobians,
             walls,
             curvature,
+        }
+    }
+
+    /// Highest `c` allowed at speed `v`, ups.
+    fn c_upper(&self, v: f64) -> f64 {
+        if self.anglemod_guard {
+            self.fl.c_plan_max(v)
+        } else {
+            self.fl.c_max(v)
         }
     }
 
@@ -270,7 +282,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
                 let dc = trust * c_trust;
                 let (mut lo, mut hi) = (
                     dc.min(u.c - pr.c_min(speed)).max(0.0),
-                    dc.min(pr.fl.c_plan_max(speed) - u.c).max(0.0),
+                    dc.min(pr.c_upper(speed) - u.c).max(0.0),
                 );
                 if u.c > kink {
                     lo = lo.min(u.c - kink);

@@ -13,10 +13,11 @@
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
-use super::baseline::{baseline, Baseline};
+use super::baseline::{baseline, GreedyGuide, GuideRun};
 use super::planner::Planner;
 use super::polish::rounded_and_polished;
-use super::relaxed::relaxed_plan;
+use super::model::FrameControl;
+use super::relaxed::{certify, count_search, relaxed_plan, RelaxedCertificate, Relaxation};
 use super::verify::{time_of, PlanPlayer};
 use super::{lower_bound, LowerBound};
 use crate::error::{Error, Result};
@@ -54,6 +55,8 @@ pub struct SearchSettings {
     pub slack_weight: f64,
     /// Wall pieces farther than this from a frame's move are left out of its sub-problem, units.
     pub wall_radius_units: f64,
+    /// Starts of the relaxed certificate, at most (the relaxed plan, then the other clean greedy runs).
+    pub certificate_starts: usize,
     /// Stop with the best valid plan after this long.
     pub time_limit: Option<Duration>,
 }
@@ -69,12 +72,14 @@ impl SearchSettings {
             tol_progress_units: 1e-6,
             slack_weight: 100.0,
             wall_radius_units: 40.0,
+            certificate_starts: 3,
             time_limit: None,
         };
         match quality {
             Quality::Fast => SearchSettings {
                 relaxed_iters: 25,
                 polish_iters: 10,
+                certificate_starts: 2,
                 tol_progress_units: 1e-3,
                 ..base
             },
@@ -84,6 +89,7 @@ impl SearchSettings {
                 relaxed_iters: 150,
                 polish_iters: 120,
                 tol_progress_units: 1e-9,
+                certificate_starts: 4,
                 ..base
             },
         }
@@ -182,6 +188,10 @@ pub struct Outcome {
     pub solve_seconds: f64,
     /// The plan's source: `greedy` or `optimised`.
     pub source: &'static str,
+    /// The guide and settings of the greedy strafer that gave the baseline.
+    pub greedy_guide: GreedyGuide,
+    /// The relaxed optimum the plan is measured against, on airborne scenes.
+    pub relaxed: Option<RelaxedCertificate>,
 }
 
 /// What the search is doing, for a progress display (the library prints nothing itself).
@@ -266,7 +276,7 @@ const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
 /// What every outcome of one solve shares: the simulation, the baseline, the bound, the start time.
 struct Finisher<'a> {
     sim: &'a Simulation<'a>,
-    greedy: &'a Trace,
+    greedy: &'a GuideRun,
     bound: &'a LowerBound,
     started: Instant,
 }
@@ -286,12 +296,14 @@ impl Finisher<'_> {
             controls,
             trace,
             engine_exact,
-            greedy: self.greedy.clone(),
+            greedy: self.greedy.trace.clone(),
             bound: self.bound.clone(),
             status,
             stats,
             solve_seconds: self.started.elapsed().as_secs_f64(),
             source,
+            greedy_guide: self.greedy.guide,
+            relaxed: None,
         }
     }
 
@@ -299,8 +311,8 @@ impl Finisher<'_> {
     /// and quantising them here could cost the frame that makes the plan no worse than greedy).
     fn greedy_outcome(&self, status: SearchStatus, stats: SearchStats) -> Outcome {
         self.outcome(
-            self.greedy.controls.clone(),
-            self.greedy.clone(),
+            self.greedy.trace.controls.clone(),
+            self.greedy.trace.clone(),
             status,
             stats,
             "greedy",
@@ -325,33 +337,42 @@ fn solve_once(
     let sim = Simulation::new(scene)?;
     let bound = lower_bound(scene, sim.corridor())?;
     // Stage 1: seed and baseline.
-    let Baseline { greedy, seed } = baseline(&sim, scene, &bound);
+    let base = baseline(&sim, scene, &bound);
+    let greedy = &base.greedy.trace;
+    let seed = base.seed();
     progress(Progress::Baseline {
         greedy_frames: greedy.crossing.map(|c| c.frames),
         bound_frames: bound.crossing.frames,
     });
     let finisher = Finisher {
         sim: &sim,
-        greedy: &greedy,
+        greedy: &base.greedy,
         bound: &bound,
         started,
     };
     if !scene.effects.is_air_only() {
         return Ok(plan_jumping_scene(&finisher, settings, deadline));
     }
-    let mut planner = Planner::new(scene, &sim, settings, &bound, &seed, deadline);
+    let mut planner = Planner::new(scene, &sim, settings, &bound, seed, deadline);
     // Stage 2: the relaxed problem; its margin leaves room for the zigzag of rounded sides.
     let fl = planner.fl;
     let zigzag = fl.tau_s * fl.law.l.max(fl.law.gamma1);
     let relaxed_margin = settings.margin_units + zigzag;
-    let warm = planner.warm_start(&seed);
+    let warm = planner.warm_start(seed);
     let prefix_len = planner.prefix.len();
     let n = seed.crossing.map_or(warm.len(), |c| {
         (c.frames as usize).saturating_sub(prefix_len)
     });
     // No plan crosses before the bound's frame.
     let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
-    let Some(relaxed) = relaxed_plan(&mut planner, progress, warm, n, lo, relaxed_margin) else {
+    let Some(relaxed) = relaxed_plan(
+        &mut planner,
+        progress,
+        warm,
+        n,
+        lo,
+        Relaxation::planning(relaxed_margin),
+    ) else {
         let status = if planner.timed_out {
             SearchStatus::TimeLimit
         } else {
@@ -361,17 +382,41 @@ fn solve_once(
         };
         return Ok(finisher.greedy_outcome(status, planner.stats));
     };
+    // The certificate: the relaxed optimum at zero margin, from the relaxed plan and the other clean
+    // greedy runs (not from a start at rest, whose first frame is the seed's own).
+    let others = if planner.prefix.is_empty() {
+        &base.clean[1.min(base.clean.len())..]
+    } else {
+        &[]
+    };
+    let starts: Vec<Vec<FrameControl>> = std::iter::once(relaxed.clone())
+        .chain(others.iter().map(|r| planner.warm_start(&r.trace)))
+        .take(settings.certificate_starts)
+        .collect();
+    let certified = certify(&mut planner, progress, starts, lo);
+    // Where another start found a faster relaxed line, that line is planned too.
+    let mut sources = vec![relaxed];
+    if let Some((_, plan)) = certified.as_ref().filter(|(_, p)| p.start_index > 0) {
+        let n = plan.controls.len();
+        let relaxation = Relaxation::planning(relaxed_margin);
+        if let Some(r) = count_search(&mut planner, progress, plan.controls.clone(), n, lo, relaxation, 1)
+        {
+            sources.push(r);
+        }
+    }
     progress(Progress::Finishing);
     // Stages 3 and 4, first with the settings' final margin; if no plan stays valid through rounding and
     // quantisation (a tight margin along a long wall), again with wider ones.
     let mut best: Option<(f64, Trace)> = None;
     for final_margin in FINAL_MARGIN_FACTORS.map(|f| f * settings.margin_units) {
-        let candidates = rounded_and_polished(&mut planner, &relaxed, relaxed_margin, final_margin);
-        for plan in candidates {
-            if let Some((t, trace)) = quantised_and_verified(&planner, plan) {
-                let limit = best.as_ref().map_or(time_of(&greedy), |b| b.0);
-                if t < limit {
-                    best = Some((t, trace));
+        for relaxed in &sources {
+            let candidates = rounded_and_polished(&mut planner, relaxed, relaxed_margin, final_margin);
+            for plan in candidates {
+                if let Some((t, trace)) = quantised_and_verified(&planner, plan) {
+                    let limit = best.as_ref().map_or(time_of(greedy), |b| b.0);
+                    if t < limit {
+                        best = Some((t, trace));
+                    }
                 }
             }
         }
@@ -380,7 +425,8 @@ fn solve_once(
         }
     }
     let stats = planner.stats;
-    Ok(match best {
+    let relaxed = certified.map(|(c, _)| c);
+    let outcome = match best {
         Some((t, trace)) => {
             let status = if planner.timed_out {
                 SearchStatus::TimeLimit
@@ -401,14 +447,15 @@ fn solve_once(
             },
             stats,
         ),
-    })
+    };
+    Ok(Outcome { relaxed, ..outcome })
 }
 
 /// Stage 4: `plan` played through the real frame with quantised yaws; its crossing time and trace when it
 /// is valid in f64 and in the engine-exact mode.
 fn quantised_and_verified(
     planner: &Planner,
-    plan: Vec<super::model::FrameControl>,
+    plan: Vec<FrameControl>,
 ) -> Option<(f64, Trace)> {
     let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan, planner.fl, true);
     let trace = planner.sim.run(&mut player);
@@ -428,7 +475,7 @@ fn plan_jumping_scene(
     if let Some(plan) = super::jumps::plan_jumps(finisher.sim, settings, deadline) {
         stats.iterations = plan.evaluations;
         let t = plan.best.time();
-        if t < time_of(finisher.greedy) {
+        if t < time_of(&finisher.greedy.trace) {
             let status = if plan.timed_out {
                 SearchStatus::TimeLimit
             } else {

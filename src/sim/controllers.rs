@@ -108,7 +108,7 @@ impl Greedy {
     }
 
     /// Arc length along the path of the point nearest to `p`.
-    fn project(&self, p: Vec2) -> f64 {
+    pub(crate) fn project(&self, p: Vec2) -> f64 {
         let mut best = (f64::INFINITY, 0.0);
         for i in 1..self.path.len() {
             let (a, b) = (self.path[i - 1], self.path[i]);
