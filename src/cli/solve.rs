@@ -181,10 +181,7 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
             ", breaks a rule"
         }
     ));
-    s.push_str(&format!(
-        "greedy guide:    {}\n",
-        o.greedy_guide
-    ));
+    s.push_str(&format!("greedy guide:    {}\n", o.greedy_guide));
     s.push_str(&format!(
         "lower bound:     {:.6} s (frame {})\n",
         lb.time, lb.frames

@@ -48,9 +48,17 @@ pub struct GreedyGuide {
 impl std::fmt::Display for GreedyGuide {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.centre_line {
-            write!(f, "centre line ({:.1} units off the walls)", self.clearance_units)?;
+            write!(
+                f,
+                "centre line ({:.1} units off the walls)",
+                self.clearance_units
+            )?;
         } else {
-            write!(f, "shortest path {:.1} units off the walls", self.clearance_units)?;
+            write!(
+                f,
+                "shortest path {:.1} units off the walls",
+                self.clearance_units
+            )?;
         }
         write!(f, ", look-ahead {:.1} units", self.lookahead_units)?;
         if let Some(cap) = self.speed_cap_ups {
@@ -137,7 +145,8 @@ fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
 
 /// The shortest path kept `extra_units` further off every wall than the hull needs, if there is one.
 fn clear_path(scene: &Scene, extra_units: f64) -> Option<Vec<Vec2>> {
-    let corridor = Corridor::with_half_width(&scene.walls, HULL_HALF_WIDTH_UNITS + extra_units).ok()?;
+    let corridor =
+        Corridor::with_half_width(&scene.walls, HULL_HALF_WIDTH_UNITS + extra_units).ok()?;
     corridor
         .shortest_path(scene.start.pos, (scene.finish.a, scene.finish.b))
         .map(|(_, path)| path)
@@ -229,7 +238,10 @@ pub(super) fn baseline(sim: &Simulation, scene: &Scene, bound: &LowerBound) -> B
                 lookahead_units: GREEDY_LOOKAHEADS_UNITS[0],
                 speed_cap_ups: None,
             },
-            trace: sim.run(&mut Greedy::new(bound.path.clone(), GREEDY_LOOKAHEADS_UNITS[0])),
+            trace: sim.run(&mut Greedy::new(
+                bound.path.clone(),
+                GREEDY_LOOKAHEADS_UNITS[0],
+            )),
         },
     };
     Baseline { greedy, clean }

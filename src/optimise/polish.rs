@@ -38,7 +38,7 @@ pub(super) fn rounded_and_polished(
         if (clean && reaches) || attempt == MARGIN_RETRIES || planner.timed_out {
             break;
         }
-        margin *= MARGIN_GROWTH;
+        margin = (margin * MARGIN_GROWTH).max(final_margin * MARGIN_GROWTH);
         relaxed = resolved_wider(planner, relaxed, margin);
     }
     candidates

@@ -141,8 +141,7 @@ pub(super) fn count_search<'a>(
         let (c, capped) = planner.stage(pr, controls.clone(), relaxed_iters);
         let states = rollout_knots(&planner.start, &c, &fl, frames_per_knot);
         let reached = model_crossing(&planner.start, &states, planner.scene);
-        let clean = problem(planner).violation(&states)
-            <= super::scp::CLEAN_VIOLATION_UNITS;
+        let clean = problem(planner).violation(&states) <= super::scp::CLEAN_VIOLATION_UNITS;
         let per = frames_per_knot as usize;
         progress(Progress::FrameCount {
             frames: n * per,

@@ -29,7 +29,12 @@ pub(super) fn round_sides(
         for &(cost, x, h) in &beam {
             for sigma in [1.0, -1.0] {
                 let y = frame(&x, FrameControl { sigma, c: u.c }, fl, false).0;
-                let dpos = (y.pos - target.pos).length_squared();
+                // Cross-track error only: every side sequence falls behind the relaxed line along the
+                // track alike (the zigzag of alternating sides shortens each move by about
+                // 1 - cos(delta / 2)), which the polish of `c` then trades off.
+                let normal = crate::physics::Vec2::from_angle(target.heading).perp();
+                let cross = (y.pos - target.pos).dot(normal);
+                let dpos = cross * cross;
                 let drift = (y.heading - target.heading) * y.speed * horizon_s;
                 history.push((h, sigma));
                 next.push((cost + dpos + drift * drift, y, history.len() - 1));

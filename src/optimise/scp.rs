@@ -71,7 +71,7 @@ impl ScpProblem<'_> {
     }
 
     /// Merit of a trajectory: progress after the last frame less the weighted violations.
-    fn merit(&self, states: &[ModelState]) -> f64 {
+    pub(super) fn merit(&self, states: &[ModelState]) -> f64 {
         let last = states.last().map_or(self.start.pos, |s| s.pos);
         self.progress(last) - self.slack_weight * self.violation(states)
     }

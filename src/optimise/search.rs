@@ -14,10 +14,10 @@
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
 use super::baseline::{baseline, GreedyGuide, GuideRun};
+use super::model::FrameControl;
 use super::planner::Planner;
 use super::polish::rounded_and_polished;
-use super::model::FrameControl;
-use super::relaxed::{certify, count_search, relaxed_plan, RelaxedCertificate, Relaxation};
+use super::relaxed::{certify, count_search, relaxed_plan, Relaxation, RelaxedCertificate};
 use super::verify::{time_of, PlanPlayer};
 use super::{lower_bound, LowerBound};
 use crate::error::{Error, Result};
@@ -395,13 +395,20 @@ fn solve_once(
         .collect();
     let certified = certify(&mut planner, progress, starts, lo);
     // Where another start found a faster relaxed line, that line is planned too.
-    let mut sources = vec![relaxed];
+    let mut sources = vec![(relaxed, relaxed_margin)];
     if let Some((_, plan)) = certified.as_ref().filter(|(_, p)| p.start_index > 0) {
         let n = plan.controls.len();
         let relaxation = Relaxation::planning(relaxed_margin);
-        if let Some(r) = count_search(&mut planner, progress, plan.controls.clone(), n, lo, relaxation, 1)
-        {
-            sources.push(r);
+        if let Some(r) = count_search(
+            &mut planner,
+            progress,
+            plan.controls.clone(),
+            n,
+            lo,
+            relaxation,
+            1,
+        ) {
+            sources.push((r, relaxed_margin));
         }
     }
     progress(Progress::Finishing);
@@ -409,8 +416,8 @@ fn solve_once(
     // quantisation (a tight margin along a long wall), again with wider ones.
     let mut best: Option<(f64, Trace)> = None;
     for final_margin in FINAL_MARGIN_FACTORS.map(|f| f * settings.margin_units) {
-        for relaxed in &sources {
-            let candidates = rounded_and_polished(&mut planner, relaxed, relaxed_margin, final_margin);
+        for (relaxed, margin) in &sources {
+            let candidates = rounded_and_polished(&mut planner, relaxed, *margin, final_margin);
             for plan in candidates {
                 if let Some((t, trace)) = quantised_and_verified(&planner, plan) {
                     let limit = best.as_ref().map_or(time_of(greedy), |b| b.0);
@@ -453,10 +460,7 @@ fn solve_once(
 
 /// Stage 4: `plan` played through the real frame with quantised yaws; its crossing time and trace when it
 /// is valid in f64 and in the engine-exact mode.
-fn quantised_and_verified(
-    planner: &Planner,
-    plan: Vec<FrameControl>,
-) -> Option<(f64, Trace)> {
+fn quantised_and_verified(planner: &Planner, plan: Vec<FrameControl>) -> Option<(f64, Trace)> {
     let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan, planner.fl, true);
     let trace = planner.sim.run(&mut player);
     let t = time_of(&trace);
