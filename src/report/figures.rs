@@ -359,7 +359,7 @@ pub fn corridor_svg(input: &ReportInput) -> io::Result<String> {
 }
 
 /// The lower bound's speed profile: the speed after each frame from the start speed, iterating
-/// [`SpeedBound::next`] (physics.md section 6), for frames `1..=frames`, as `(time s, speed ups)`.
+/// [`SpeedBound::next`] (docs/physics.md section 6), for frames `1..=frames`, as `(time s, speed ups)`.
 pub fn bound_speed_profile(input: &ReportInput, frames: u64) -> Vec<(f64, f64)> {
     let scene = input.scene;
     let bound = SpeedBound::new(&scene.vars, scene.effects);
@@ -554,7 +554,7 @@ pub fn angles_svg(input: &ReportInput) -> io::Result<String> {
     })
 }
 
-/// The radius of the circle through each frame's position and its neighbours' (physics.md section 9),
+/// The radius of the circle through each frame's position and its neighbours' (docs/physics.md section 9),
 /// against the speed at the middle position, as `(speed ups, radius units)`; straight stretches (infinite
 /// radius) are left out.
 pub fn turn_radii(trace: &Trace) -> Vec<(f64, f64)> {
@@ -615,7 +615,7 @@ pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
     svg_figure(520, |root| {
         let mut chart = ChartBuilder::on(root)
             .caption(
-                "Turn radius per frame against speed (physics.md section 9)",
+                "Turn radius per frame against speed (docs/physics.md section 9)",
                 ("sans-serif", 20),
             )
             .margin(MARGIN_PX)

@@ -124,7 +124,7 @@ pub fn write_html(input: &ReportInput, w: &mut impl Write) -> io::Result<()> {
             figures::speed_svg(input),
             format!(
                 "Figure 2. Speed against time. The grey dashed curve is the lower bound's speed profile: \
-                 the largest speed any control sequence can have after each frame (physics.md section 6); \
+                 the largest speed any control sequence can have after each frame (docs/physics.md section 6); \
                  the vertical lines mark the crossings (lower bound at {:.4} s).",
                 input.bound.crossing.time
             ),
@@ -142,7 +142,7 @@ pub fn write_html(input: &ReportInput, w: &mut impl Write) -> io::Result<()> {
             "Figure 4. The radius of the circle through each position and its neighbours, against speed. \
              The curves are maximum-acceleration airstrafing at these settings: the source text's relation \
              (dashed) gives about twice the radius the game draws; the first-order radius (solid) is the \
-             one corners are planned with (physics.md section 9)."
+             one corners are planned with (docs/physics.md section 9)."
                 .to_string(),
         ),
     ];
@@ -238,7 +238,7 @@ fn write_radius_table(input: &ReportInput, w: &mut impl Write) -> io::Result<()>
     let vars = &input.scene.vars;
     writeln!(
         w,
-        "<h2>The radius-speed relation (physics.md section 9)</h2>\n<p>Maximum-acceleration airstrafing at \
+        "<h2>The radius-speed relation (docs/physics.md section 9)</h2>\n<p>Maximum-acceleration airstrafing at \
          {} fps: the source text's relation against the radius the game draws.</p>\n<table id=\"radii\">\n\
          <tr><th>speed (ups)</th><th>theta (deg)</th><th>source text's relation</th><th>first order</th>\
          <th>circle through 3 simulated positions</th><th>relation / measured</th></tr>",
