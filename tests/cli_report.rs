@@ -1,4 +1,4 @@
-//! `simulate --report`, `simulate --hltas` and `report RESULT.json -o` through the real binary (issue 6).
+//! `simulate --report`, `simulate --hltas` and `report RESULT.json -o` through the real binary.
 
 use hltas::types::AutoMovement;
 use hltas::HLTAS;
