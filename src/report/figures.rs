@@ -7,7 +7,7 @@ use super::html::{ReportInput, ReportRun};
 use crate::geometry::{BoundaryKind, HULL_HALF_WIDTH_UNITS};
 use crate::optimise::bound::SpeedBound;
 use crate::physics::curvature::{circumradius, max_accel_radii};
-use crate::physics::Vec2;
+use crate::physics::{MovementVars, Vec2};
 use crate::sim::{FrameRecord, Trace};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -734,12 +734,17 @@ pub fn turn_radii(trace: &Trace) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Figure 4: the turn radius of every frame against speed (log scale), with the section-9 relations of
-/// maximum-acceleration airstrafing drawn over it: the source text's relation and the first-order radius
-/// `tau |v'|^2 / (mu sin theta)` (which the circle through three simulated positions follows).
-pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
-    let vars = &input.scene.vars;
-    let points: Vec<Vec<(f64, f64)>> = input.runs.iter().map(|r| turn_radii(r.trace)).collect();
+/// The radius figure's axes: the speeds shown, the radii shown (log scale), and the section-9 relations of
+/// maximum-acceleration airstrafing sampled over those speeds as `(speed, source text's, first order)`.
+struct RadiusAxes {
+    speed: (f64, f64),
+    radius: (f64, f64),
+    relations: Vec<(f64, f64, f64)>,
+}
+
+/// Axes that hold the runs' radii `points` and the relations; without points, speeds from the max speed to
+/// three times it.
+fn radius_axes(vars: &MovementVars, points: &[Vec<(f64, f64)>]) -> RadiusAxes {
     let (mut v_lo, mut v_hi) = value_range(points.iter().flatten().map(|p| p.0), 0.0);
     if points.iter().all(Vec::is_empty) {
         (v_lo, v_hi) = (vars.maxspeed, 3.0 * vars.maxspeed);
@@ -753,14 +758,11 @@ pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
             (v, r.source_text, r.first_order)
         })
         .collect();
-    let relation_max = relations
-        .iter()
-        .flat_map(|r| [r.1, r.2])
+    let relation_radii = || relations.iter().flat_map(|r| [r.1, r.2]);
+    let relation_max = relation_radii()
         .filter(|r| r.is_finite())
         .fold(0.0, f64::max);
-    let relation_min = relations
-        .iter()
-        .flat_map(|r| [r.1, r.2])
+    let relation_min = relation_radii()
         .filter(|r| r.is_finite() && *r > 0.0)
         .fold(f64::INFINITY, f64::min);
     let data_min = points
@@ -777,6 +779,23 @@ pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
     };
     let r_lo = (data_min.min(relation_min) * 0.8).clamp(1e-3, 1e9);
     let r_hi = (data_max.max(relation_max).min(cap) * 1.25).max(r_lo * 10.0);
+    RadiusAxes {
+        speed: (v_lo, v_hi),
+        radius: (r_lo, r_hi),
+        relations,
+    }
+}
+
+/// Figure 5: the turn radius of every frame against speed (log scale), with the section-9 relations of
+/// maximum-acceleration airstrafing drawn over it: the source text's relation and the first-order radius
+/// `tau |v'|^2 / (mu sin theta)` (which the circle through three simulated positions follows).
+pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
+    let points: Vec<Vec<(f64, f64)>> = input.runs.iter().map(|r| turn_radii(r.trace)).collect();
+    let RadiusAxes {
+        speed: (v_lo, v_hi),
+        radius: (r_lo, r_hi),
+        relations,
+    } = radius_axes(&input.scene.vars, &points);
     let x_pad = 0.03 * (v_hi - v_lo);
     svg_figure(520, |root| {
         let mut chart = ChartBuilder::on(root)

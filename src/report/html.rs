@@ -111,7 +111,36 @@ pub fn write_html(input: &ReportInput, w: &mut impl Write) -> io::Result<()> {
 
     write_runs_table(input, w)?;
 
-    let figures: [(&str, io::Result<String>, String); 5] = [
+    for (id, svg, caption) in captioned_figures(input) {
+        let svg = svg?;
+        writeln!(
+            w,
+            "<figure id=\"{id}\">\n{svg}\n<figcaption>{}</figcaption>\n</figure>",
+            escape(&caption)
+        )?;
+    }
+
+    write_radius_table(input, w)?;
+
+    writeln!(w, "<h2>Summary</h2>")?;
+    writeln!(
+        w,
+        "<table id=\"{SUMMARY_TABLE_ID}\">\n<tr><th>key</th><th>value</th></tr>"
+    )?;
+    for (key, value) in flatten_json(input.summary) {
+        writeln!(
+            w,
+            "<tr><td>{}</td><td>{}</td></tr>",
+            escape(&key),
+            escape(&value)
+        )?;
+    }
+    writeln!(w, "</table>\n</body>\n</html>")
+}
+
+/// The five figures in order, each with its element id (from [`FIGURE_IDS`]) and its caption.
+fn captioned_figures(input: &ReportInput) -> [(&'static str, io::Result<String>, String); 5] {
+    [
         (
             FIGURE_IDS[0],
             figures::corridor_svg(input),
@@ -157,32 +186,7 @@ pub fn write_html(input: &ReportInput, w: &mut impl Write) -> io::Result<()> {
              one corners are planned with (docs/physics.md section 9)."
                 .to_string(),
         ),
-    ];
-    for (id, svg, caption) in figures {
-        let svg = svg?;
-        writeln!(
-            w,
-            "<figure id=\"{id}\">\n{svg}\n<figcaption>{}</figcaption>\n</figure>",
-            escape(&caption)
-        )?;
-    }
-
-    write_radius_table(input, w)?;
-
-    writeln!(w, "<h2>Summary</h2>")?;
-    writeln!(
-        w,
-        "<table id=\"{SUMMARY_TABLE_ID}\">\n<tr><th>key</th><th>value</th></tr>"
-    )?;
-    for (key, value) in flatten_json(input.summary) {
-        writeln!(
-            w,
-            "<tr><td>{}</td><td>{}</td></tr>",
-            escape(&key),
-            escape(&value)
-        )?;
-    }
-    writeln!(w, "</table>\n</body>\n</html>")
+    ]
 }
 
 const STYLE: &str = "body{font-family:sans-serif;margin:2em;max-width:1000px;color:#222}\
