@@ -1,4 +1,4 @@
-//! The minimal-time search. Min-time is fixed-N maximal progress plus a search over N: for a
+//! The minimal-time search (issue 5). Min-time is fixed-N maximal progress plus a search over N: for a
 //! frame count N, sequential convex programming maximises how far past the finish line the player is after
 //! frame N, keeping every frame's straight move clear of the walls by a margin; N is then lowered to the
 //! frame before the plan's crossing until the line can no longer be reached. The fractional crossing time
@@ -10,8 +10,8 @@
 //! a trust region in between). argmin's executor owns the loop, the iteration cap and the time limit.
 //! From the second iteration on, the sub-step also carries the curvature of the Lagrangian, weighted by
 //! the last sub-step's dynamics duals and convexified ([`super::lagrangian`]): a sequential quadratic
-//! program. Its model is right to second order, so its steps are long where a linear model's are short
-//! (the measurement is in docs/design.md).
+//! program. Its model is right to second order, so its steps are long where the linear model's were
+//! not: on the 100 fps bend 32 sub-steps instead of 283, and a better plan (4.00146 s against 4.00196 s).
 //!
 //! Stages: (0) on long runs (at least twice [`COARSE_KNOTS`] frames), coarse to fine: the relaxed problem
 //! over knots of several frames played with one control ([`knot`]: the same interface as a frame, so the
@@ -866,7 +866,7 @@ fn solve_once(
     // anglemod, and quantising them here could cost the frame that makes the plan no worse than greedy).
     let greedy_plan = (greedy.controls.clone(), greedy.clone());
     if !scene.effects.is_air_only() {
-        // Jumping scenes with the Source boost: the policy search of `jumps`. It keeps a plan
+        // Jumping scenes with the Source boost: the policy search of `jumps` (issue 7). It keeps a plan
         // only if it is valid in f64 and engine-exact; greedy stays the answer when it is faster.
         if let Some(plan) = super::jumps::plan_jumps(&sim, settings, deadline) {
             stats.iterations = plan.evaluations;
