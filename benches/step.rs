@@ -24,7 +24,7 @@ fn wishes() -> Vec<Wish> {
         .collect()
 }
 
-/// The airborne frame written out by hand: wish direction, the FME (physics.md section 5), the move.
+/// The airborne frame written out by hand: wish direction, the FME (docs/physics.md section 5), the move.
 #[inline(never)]
 fn minimal_air_frames(s: &mut PlayerState, wishes: &[Wish], vars: &MovementVars) {
     let tau = vars.frame_time_s();

@@ -1,4 +1,4 @@
-//! What accuracy costs in time (issue 8): one scene measured at every accuracy level, from the analytic
+//! What accuracy costs in time: one scene measured at every accuracy level, from the analytic
 //! lower bound through the greedy strafer and `solve` at each quality to the engine-exact replay, each
 //! with its wall time, frames, game time and gap to the lower bound; beside each solve, the hill-climbing
 //! baseline ([`crate::optimise::hillclimb`]) given the same wall time. [`measure_scaling`] runs the same
@@ -102,7 +102,7 @@ pub struct BenchRow {
     pub evaluations: Option<u64>,
     /// Why it stopped, or other detail.
     pub status: Option<String>,
-    /// The radius-speed corner limit of a 90-degree bend (physics.md section 9), ups.
+    /// The radius-speed corner limit of a 90-degree bend (docs/physics.md section 9), ups.
     pub corner_speed_ups: Option<f64>,
     /// Scaling rows after the first: this row's wall time over the first row's.
     pub wall_ratio: Option<f64>,

@@ -1,6 +1,6 @@
-//! The frame-level accelerated-backhop run (`sim::abh`, physics.md sections 3, 10, 11) on
+//! The frame-level accelerated-backhop run (`sim::abh`, docs/physics.md sections 3, 10, 11) on
 //! `scenarios/hl2-abh-100m.toml`: hop frames, speeds and the crossing time pinned against an independent
-//! one-dimensional re-derivation from physics.md's formulas; the lane kept (also engine-exact); the CLI.
+//! one-dimensional re-derivation from docs/physics.md's formulas; the lane kept (also engine-exact); the CLI.
 
 use assert_cmd::Command;
 use serde_json::Value;
@@ -11,7 +11,7 @@ use strafeopt::sim::abh::{boost_addition, jump_airtime_s, run_abh, Abh, AbhParam
 use strafeopt::sim::{Controller, Simulation};
 
 const SCENE: &str = "scenarios/hl2-abh-100m.toml";
-/// 100 m in units (physics.md section 1).
+/// 100 m in units (docs/physics.md section 1).
 const DISTANCE_UNITS: f64 = 5249.34;
 
 fn scene() -> Scene {
@@ -25,7 +25,7 @@ fn run(params: AbhParams) -> AbhRun {
     run_abh(&sim, params)
 }
 
-/// The run re-derived in one dimension from physics.md alone (no `Stepper`): the unduck frames, ground
+/// The run re-derived in one dimension from docs/physics.md alone (no `Stepper`): the unduck frames, ground
 /// friction (section 4) and the ground FME along the velocity (section 5) while walking, the boost
 /// (section 11) on jump frames, the per-component clamp (section 10), and the discrete airtime of the jump
 /// (section 3: the jump speed replaces the first half-step, landing within the 2-unit layer).

@@ -1,4 +1,4 @@
-//! The lower bound's speed profile (physics.md section 6): no control sequence, whatever its angles, keys,
+//! The lower bound's speed profile (docs/physics.md section 6): no control sequence, whatever its angles, keys,
 //! jumps or ducks, covers more path after n frames than the greedy profile, so the time the profile needs
 //! for a distance is a lower bound on every run's time over it.
 

@@ -1,4 +1,4 @@
-//! `strafeopt calc` through the real binary: the figures of physics.md section 12 in text and `--json`,
+//! `strafeopt calc` through the real binary: the figures of docs/physics.md section 12 in text and `--json`,
 //! and bad input giving one line and exit code 2.
 
 use serde_json::Value;

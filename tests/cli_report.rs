@@ -1,4 +1,4 @@
-//! `simulate --report`, `simulate --hltas` and `report RESULT.json -o` through the real binary (issue 6).
+//! `simulate --report`, `simulate --hltas` and `report RESULT.json -o` through the real binary.
 
 use hltas::types::AutoMovement;
 use hltas::HLTAS;
@@ -61,7 +61,10 @@ fn simulate_report_and_report_command_write_the_same_page() {
     );
     std::fs::write(&result, &out.stdout).unwrap_or_else(|e| panic!("{e}"));
     let page = read(&html);
-    assert_eq!(page.matches("<svg").count(), 4);
+    assert_eq!(
+        page.matches("<svg").count(),
+        strafeopt::report::html::FIGURE_IDS.len()
+    );
     assert!(page.contains("<table id=\"summary\">"));
     // The greedy run breaks the hairpin's rule: marked in the corridor.
     let frame = v["first_rule_violation_frame"].as_u64().unwrap_or(0);

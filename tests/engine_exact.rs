@@ -1,4 +1,4 @@
-//! Engine-exact replay (physics.md section 1): a planned control sequence run in the game's arithmetic
+//! Engine-exact replay (docs/physics.md section 1): a planned control sequence run in the game's arithmetic
 //! (f32 state, anglemod yaw) drifts from the f64 plan by rounding alone when the plan's yaws are
 //! anglemod steps, and by much more when they are not.
 

@@ -1,5 +1,5 @@
 //! Corridor queries against brute force: the swept hull (cast and sweep), clearances, rule boundaries,
-//! finish crossings and the shortest path (physics.md section 10). Seeds are fixed.
+//! finish crossings and the shortest path (docs/physics.md section 10). Seeds are fixed.
 
 use strafeopt::geometry::{
     BoundaryKind, Cast, Corridor, FinishLine, FinishPoint, SweepStatus, Wall, CONTACT_TOL_UNITS,

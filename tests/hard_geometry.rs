@@ -4,7 +4,7 @@
 //! (the real binary) are exercised.
 //!
 //! **Decision: a corridor exactly one hull wide (32 units) is accepted.** The hull may touch a wall but
-//! not overlap it (clearance 0 is contact, physics.md section 10), so the hull centre has exactly one line to
+//! not overlap it (clearance 0 is contact, docs/physics.md section 10), so the hull centre has exactly one line to
 //! travel on: the shortest path exists, runs along that line with clearance 0 to both walls, and the lower
 //! bound is finite. With solid walls every move is clipped back onto the line; with rule walls only runs
 //! whose velocity stays exactly along the line are valid (the greedy strafer breaks a rule in frame 1,
@@ -316,7 +316,7 @@ fn one_hull_wide_lane_is_a_single_line_with_clearance_zero() {
 fn one_hull_wide_rule_lane_admits_only_runs_along_the_line() {
     let s = scene(&format!("{AIR}{}", lane(32.0, 2000.0, "rule")));
     // Holding forward along the line: at 320 ups in the air, gamma2 = 30 - 320 < 0, so mu = 0 and the
-    // velocity never changes (physics.md section 5): the line x = 2000 is reached after 1960 / 320 s.
+    // velocity never changes (docs/physics.md section 5): the line x = 2000 is reached after 1960 / 320 s.
     let t = run(&s, &mut forward_along_x());
     assert_trace_finite(&t);
     assert!(t.feasible(), "{:?}", t.first_rule_violation());
@@ -420,7 +420,7 @@ fn a_one_hull_wide_bend_turns_on_a_single_point() {
     // Hold forward along +x until the end wall stops the hull in the corner, then forward along +y. Hand:
     // 320 ups covers 484 - 40 = 444 units in 138.75 frames; in frame 139 the end wall stops the hull dead
     // at (484, 16) (velocity clipped to 0: gamma1 = 32 > L = 30 at 100 fps, so holding forward adds
-    // nothing). From rest, forward gives mu = gamma2 = L - |v| (physics.md section 5), so the speed is 30
+    // nothing). From rest, forward gives mu = gamma2 = L - |v| (docs/physics.md section 5), so the speed is 30
     // ups from frame 140 on: the line y = 500 is 484 units away, 1613.33 frames, so it is crossed in frame
     // 139 + 1614 = 1753, a third of the way through.
     let mut controls = vec![

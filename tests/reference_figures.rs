@@ -1,4 +1,4 @@
-//! Every figure of physics.md section 12 (and the worked numbers of sections 9-11), reproduced through
+//! Every figure of docs/physics.md section 12 (and the worked numbers of sections 9-11), reproduced through
 //! the library to the printed precision.
 
 use strafeopt::physics::closed_form::{
@@ -41,7 +41,7 @@ fn airstrafe_0_to_2000_at_aa100_1000_fps_takes_about_4_4_s() {
 
 #[test]
 fn radius_relation_is_about_twice_the_measured_circle() {
-    // physics.md section 9: v = 500, 100 fps, theta = 90 deg: 167 by the relation, 83.8 measured.
+    // docs/physics.md section 9: v = 500, 100 fps, theta = 90 deg: 167 by the relation, 83.8 measured.
     let vars = MovementVars::goldsrc(100.0);
     let r = max_accel_radii(&vars, 500.0);
     assert_eq!(format!("{:.0}", r.theta_rad.to_degrees()), "90");

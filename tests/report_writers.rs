@@ -1,4 +1,4 @@
-//! The report writers on `Vec<u8>` (issue 6): the HTML report (four SVG figures and the summary table,
+//! The report writers on `Vec<u8>`: the HTML report (five SVG figures and the summary table,
 //! one or two runs, deterministic), the trajectory CSV / JSON, the `.hltas` script, and rebuilding a
 //! saved result.
 
@@ -8,10 +8,12 @@ use serde_json::Value;
 use std::path::Path;
 use strafeopt::cli::{report_cmd, simulate::summary_json};
 use strafeopt::optimise::{lower_bound, LowerBound};
+use strafeopt::physics::strafe::{max_accel_control, strafe_keys};
 use strafeopt::physics::Side;
-use strafeopt::report::{self, html, write_html, ReportInput};
+use strafeopt::physics::{Control, PlayerState};
+use strafeopt::report::{self, figures, html, write_html, ReportInput};
 use strafeopt::scene::Scene;
-use strafeopt::sim::{Greedy, SideStrafer, Simulation, Trace};
+use strafeopt::sim::{Controller, Greedy, SideStrafer, Simulation, Trace};
 
 const SCENE: &str = "scenarios/hl-bend90-100fps.toml";
 const LOOKAHEAD: f64 = 300.0;
@@ -43,7 +45,7 @@ fn svgs(html: &str) -> Vec<&str> {
 }
 
 #[test]
-fn html_has_four_figures_and_the_summary_table() {
+fn html_has_five_figures_and_the_summary_table() {
     let scene = scene();
     let (bound, greedy, _) = runs(&scene);
     let summary = summary_json(&scene, &greedy, &bound, Some(LOOKAHEAD));
@@ -51,7 +53,7 @@ fn html_has_four_figures_and_the_summary_table() {
     let page = html_of(&input);
     assert!(page.starts_with("<!DOCTYPE html>") && page.trim_end().ends_with("</html>"));
     let figures = svgs(&page);
-    assert_eq!(figures.len(), 4, "four inline SVG figures");
+    assert_eq!(figures.len(), 5, "five inline SVG figures");
     for (svg, id) in figures.iter().zip(html::FIGURE_IDS) {
         assert!(page.contains(&format!("<figure id=\"{id}\">")), "{id}");
         let drawn = svg.matches("<polyline").count() + svg.matches("<path").count();
@@ -61,7 +63,13 @@ fn html_has_four_figures_and_the_summary_table() {
     assert!(!page.contains("<script") && !page.contains("src="));
     // The corridor shows the hull boxes and the rule lines; the radius figure shows the run's radii.
     assert!(figures[0].matches("<rect").count() >= 6);
-    assert!(figures[3].matches("<circle").count() >= 100);
+    assert!(figures[4].matches("<circle").count() >= 100);
+    // The turn rate's window is named; the clearance figure marks the run's smallest clearance.
+    assert!(figures[2].contains(&format!(
+        "averaged over {} frames",
+        figures::TURN_RATE_WINDOW_FRAMES
+    )));
+    assert!(figures[3].contains(&format!("greedy: min {:.4} units", greedy.min_clearance())));
     // The summary table holds the --json keys, nested ones dotted.
     assert!(page.contains(&format!("<table id=\"{}\">", html::SUMMARY_TABLE_ID)));
     for key in [
@@ -95,7 +103,7 @@ fn a_second_labelled_run_is_one_call() {
         .with_run("greedy", &greedy)
         .with_run("optimised", &right);
     let page = html_of(&input);
-    assert_eq!(svgs(&page).len(), 4);
+    assert_eq!(svgs(&page).len(), 5);
     assert!(page.contains("<td>optimised</td><td>max-accel-right</td>"));
     // Each figure has a legend entry for both runs.
     for svg in svgs(&page) {
@@ -200,7 +208,7 @@ fn a_result_with_plans_is_rebuilt() {
 }
 
 #[test]
-fn degenerate_inputs_still_draw_four_figures() {
+fn degenerate_inputs_still_draw_five_figures() {
     // No walls at all, a short frame cap the run never finishes in, and a run of no frames.
     let text = r#"
 name = "open"
@@ -235,11 +243,94 @@ b = [5000, 100]
         .with_run("left", &left)
         .with_run("empty", &empty);
     let page = html_of(&input);
-    assert_eq!(svgs(&page).len(), 4);
+    assert_eq!(svgs(&page).len(), 5);
     assert!(page.contains("not reached") && page.contains("no walls"));
     // No runs at all: the figures are drawn with the corridor and the bound alone.
     let page = html_of(&ReportInput::new(&scene, &bound, &summary));
-    assert_eq!(svgs(&page).len(), 4);
+    assert_eq!(svgs(&page).len(), 5);
     // The script of an empty run is refused, not written.
     assert!(report::hltas_script(&empty, &scene.vars, "open").is_err());
+}
+
+/// Maximum acceleration on alternating sides, left on odd frames: the velocity zigzags about a straight
+/// line (a few degrees left of the start's heading, as the first frame turns left).
+struct Alternating;
+
+impl Controller for Alternating {
+    fn name(&self) -> String {
+        "alternating".to_string()
+    }
+
+    fn control(&mut self, frame: u64, s: &PlayerState, sim: &Simulation) -> Control {
+        let side = if frame % 2 == 1 {
+            Side::Left
+        } else {
+            Side::Right
+        };
+        let keys = strafe_keys(sim.scene().vars.side_key_speed);
+        max_accel_control(sim.stepper(), s, keys, side, s.vel.angle())
+    }
+}
+
+#[test]
+fn heading_and_turn_rate_of_a_straight_alternating_run_stay_level() {
+    let text = r#"
+name = "straight"
+[engine]
+preset = "goldsrc"
+fps = 100
+effects = ["air-accel", "max-velocity", "walls"]
+[lane]
+width = 1024
+length = 3000
+kind = "rule"
+"#;
+    let scene = Scene::from_toml_str(text, "straight.toml").unwrap_or_else(|e| panic!("{e}"));
+    let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let run = sim.run(&mut Alternating);
+    assert!(run.feasible(), "the alternating run stays in the lane");
+    // The heading zigzags by a few degrees about the lane and does not drift.
+    let heading = figures::heading_degrees(&run);
+    assert_eq!(heading.len(), run.frames.len() + 1);
+    assert!(heading.iter().all(|h| h.1.abs() < 10.0), "{heading:?}");
+    // Averaged over the window, the turn rate is near zero; one side alone turns hundreds of degrees a
+    // second.
+    let rates = figures::turn_rate_deg_per_s(&run);
+    assert_eq!(
+        rates.len(),
+        heading.len() - figures::TURN_RATE_WINDOW_FRAMES
+    );
+    let worst = rates.iter().map(|r| r.1.abs()).fold(0.0, f64::max);
+    assert!(worst < 5.0, "largest turn rate {worst} deg/s");
+    let left = sim.run(&mut SideStrafer { side: Side::Left });
+    let turning = figures::turn_rate_deg_per_s(&left);
+    // 30 ups of turn a frame at 320 ups, 100 fps: about 530 degrees per second, slowing as it speeds up.
+    assert!((turning[0].1 - 530.0).abs() < 10.0, "{:?}", &turning[..5]);
+    assert!(turning.iter().all(|r| r.1 > 0.0));
+}
+
+#[test]
+fn heading_and_clearance_of_the_greedy_bend() {
+    let scene = scene();
+    let (_, greedy, _) = runs(&scene);
+    // Into the bend along +x, out of it along +y: a quarter turn to the left.
+    let heading = figures::heading_degrees(&greedy);
+    let (first, last) = (heading[0].1, heading[heading.len() - 1].1);
+    assert!(
+        first.abs() < 20.0 && (last - 90.0).abs() < 20.0,
+        "{first} -> {last}"
+    );
+    let rates = figures::turn_rate_deg_per_s(&greedy);
+    let mean_rate = rates.iter().map(|r| r.1).sum::<f64>() / rates.len() as f64;
+    assert!(mean_rate > 0.0, "turns left on average: {mean_rate}");
+    // The clearance series is the start and every frame; its minimum is the run's min clearance (the same
+    // values, so exactly equal).
+    let clearance = figures::clearance_series(&greedy);
+    assert_eq!(clearance.len(), greedy.frames.len() + 1);
+    let min = clearance.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    assert_eq!(min, greedy.min_clearance());
+    assert!(
+        (0.0..16.0).contains(&min),
+        "greedy hugs the inner corner: {min}"
+    );
 }

@@ -977,7 +977,7 @@ fn huge_coordinates_and_speeds_are_refused_with_their_key() {
 }
 
 /// Scenes whose runs used to overflow: huge but finite movement variables, and the Source jump boost
-/// without `max-velocity` (accelerated backhopping doubles the speed every hop, physics.md section 11).
+/// without `max-velocity` (accelerated backhopping doubles the speed every hop, docs/physics.md section 11).
 /// Physics now refuses both (`MovementVars::validate` bounds every magnitude; `jump-boost` requires
 /// `max-velocity`), so each gives a clean error.
 #[test]

@@ -105,7 +105,7 @@ fn shipped_scenes_greedy_and_bound_are_pinned() {
         assert!((c.time - time).abs() < TOL_TIME_S, "{name}: greedy {c:?}");
         assert_eq!(trace.feasible(), valid, "{name}: greedy validity");
         if trace.feasible() {
-            // No valid run beats the bound (physics.md section 6).
+            // No valid run beats the bound (docs/physics.md section 6).
             assert!(
                 c.time >= bound.crossing.time,
                 "{name}: {} < bound {}",

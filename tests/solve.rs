@@ -260,7 +260,7 @@ fn a_start_at_rest_is_planned_after_its_first_frame() {
 
 #[test]
 fn a_start_too_fast_for_the_corner_brakes_before_it() {
-    // 1500 ups into a corner that takes about 1144: the capped greedy strafer brakes (physics.md
+    // 1500 ups into a corner that takes about 1144: the capped greedy strafer brakes (docs/physics.md
     // section 7) down to its cap instead of accelerating away, and the search starts from it. Greedy 350
     // frames, the plan 328 (fast); before, both failed and the scene was called impassable (exit 3).
     let (o, plan) = solved(&bend_from([1500.0, 0.0]), Quality::Fast);

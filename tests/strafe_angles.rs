@@ -1,4 +1,4 @@
-//! The analytic strafe angles of physics.md sections 6-9 against brute-force scans of theta over random
+//! The analytic strafe angles of docs/physics.md sections 6-9 against brute-force scans of theta over random
 //! speeds and settings: the analytic choice must be at least as good as the best of tens of thousands of
 //! samples, and finite everywhere.
 
@@ -82,7 +82,7 @@ proptest! {
 
     #[test]
     fn common_case_decel_is_cos_minus_one(lambda in 0.0..3000.0f64, l in 1.0..320.0f64, frac in 0.0..1.0f64) {
-        // physics.md section 7: gamma1 >= 0, L >= 0, L - gamma1 >= 0 gives | lambda - gamma1 |.
+        // docs/physics.md section 7: gamma1 >= 0, L >= 0, L - gamma1 >= 0 gives | lambda - gamma1 |.
         let law = AccelLaw { l, gamma1: frac * l };
         let (_, sp) = max_decel(lambda, law);
         prop_assert!((sp - (lambda - law.gamma1).abs()).abs() < 1e-9 * (1.0 + lambda));

@@ -91,7 +91,7 @@ pub enum ControllerArg {
     MaxAccelLeft,
     /// Maximum acceleration turning right every frame.
     MaxAccelRight,
-    /// Accelerated backhopping (Source scenes; physics.md section 11): stand up, walk, a forward jump, then
+    /// Accelerated backhopping (Source scenes; docs/physics.md section 11): stand up, walk, a forward jump, then
     /// ducked backhops facing backwards, steering on the jump frames to hold the lane.
     Abh,
 }

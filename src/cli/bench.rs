@@ -1,4 +1,4 @@
-//! `strafeopt bench`: what accuracy costs in time (issue 8). Loads the scenes, runs
+//! `strafeopt bench`: what accuracy costs in time. Loads the scenes, runs
 //! [`crate::bench::measure_scene`] on each and [`crate::bench::measure_scaling`] on the first, and prints
 //! an aligned table or (`--json`) one array of rows; `--svg` writes gap against wall time.
 

@@ -401,7 +401,7 @@ fn abh_table(
     })
 }
 
-/// The scene of the frame-level ABH run for `calc abh` (physics.md section 11): the resolved variables with
+/// The scene of the frame-level ABH run for `calc abh` (docs/physics.md section 11): the resolved variables with
 /// max speed `max_speed`, every effect the run needs, a 64.04-unit rule lane (1.22 m) whose line is
 /// `distance` units from the start, a crouched start at rest. Written as a scene file and loaded, so it is
 /// validated like any other scene.
@@ -428,7 +428,7 @@ fn abh_scene_toml(vars: &MovementVars, max_speed: f64, distance: f64) -> String 
     )
 }
 
-/// The lane width of the 100 m, units (1.22 m, physics.md section 1).
+/// The lane width of the 100 m, units (1.22 m, docs/physics.md section 1).
 const ABH_LANE_WIDTH_UNITS: f64 = 64.04;
 
 /// The frame-level ABH run (`sim::abh`) beside the article's model: hops, the time from the pistol to the

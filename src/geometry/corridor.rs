@@ -1,5 +1,5 @@
 //! The corridor: every wall segment of a scene grown by the player's box, with the clearance and
-//! rule-boundary queries (physics.md section 10).
+//! rule-boundary queries (docs/physics.md section 10).
 //!
 //! Performance: each query scans all segments (six dot products per segment for inside tests and casts), which
 //! is the right trade for corridors of tens of segments; a BVH would pay off only past about a hundred.

@@ -1,5 +1,5 @@
 //! A wall segment grown by the player's box: the Minkowski sum of a segment and an axis-aligned square,
-//! the set of hull centres at which the hull overlaps or touches the segment (physics.md section 10).
+//! the set of hull centres at which the hull overlaps or touches the segment (docs/physics.md section 10).
 //!
 //! The sum of two convex polygons has as edge normals the union of theirs, and each edge's offset is the
 //! sum of the two support functions. So the grown segment is exactly the intersection of six half-planes

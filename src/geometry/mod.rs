@@ -1,4 +1,4 @@
-//! The corridor and the player's swept hull (physics.md section 10), over parry2d's f64 shapes.
+//! The corridor and the player's swept hull (docs/physics.md section 10), over parry2d's f64 shapes.
 //!
 //! The player is an axis-aligned box, [`HULL_HALF_WIDTH_UNITS`] on each side of its centre, that never
 //! rotates; only its 32 x 32 footprint meets walls. Every query here reduces to the hull *centre* against a
@@ -29,7 +29,7 @@ pub use separate::{HalfPlane, Separation};
 pub use sweep::{Cast, Contact, SweepResult, SweepStatus};
 pub use wall::{BoundaryKind, Wall, WallDefect};
 
-/// Half the width of the player's box, units: the hull is 32 x 32 units in the plane (physics.md
+/// Half the width of the player's box, units: the hull is 32 x 32 units in the plane (docs/physics.md
 /// section 2), for standing and ducked players alike.
 pub const HULL_HALF_WIDTH_UNITS: f64 = 16.0;
 
@@ -42,7 +42,7 @@ pub const CONTACT_TOL_UNITS: f64 = 1e-9;
 pub const MIN_SEGMENT_LENGTH_UNITS: f64 = 1e-9;
 
 /// Moves tried per frame against solid walls: the first plus three retries after clipping (GoldSrc
-/// `PM_FlyMove`'s `numbumps`, physics.md section 10).
+/// `PM_FlyMove`'s `numbumps`, docs/physics.md section 10).
 pub const MAX_BUMPS_PER_FRAME: usize = 4;
 
 /// How much the grown walls are shrunk for [`Corridor::shortest_path`], units, so that a path that touches
@@ -50,5 +50,5 @@ pub const MAX_BUMPS_PER_FRAME: usize = 4;
 /// units at corridor scale). Shrinking keeps the result a lower bound: it can only shorten the path, by at
 /// most a few times this value. It is exactly the contact tolerance, so the path search admits the same
 /// hull positions as the simulation and the scene validator (touching, or at most [`CONTACT_TOL_UNITS`]
-/// deep): a larger value let "a path exists" squeeze through gaps too narrow for the hull (issue 9).
+/// deep): a larger value would let "a path exists" squeeze through gaps too narrow for the hull.
 pub const PATH_SHRINK_UNITS: f64 = CONTACT_TOL_UNITS;

@@ -1,5 +1,5 @@
 //! The shortest path of the hull centre through the corridor, a lower bound on the distance any valid
-//! path travels (physics.md section 6: the greedy speed profile over this distance bounds the time).
+//! path travels (docs/physics.md section 6: the greedy speed profile over this distance bounds the time).
 //!
 //! The hull may not overlap any wall, solid or rule, so its centre must stay out of the interior of every
 //! wall segment grown by the box (a convex hexagon). The shortest path among polygonal obstacles is a

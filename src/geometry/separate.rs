@@ -1,4 +1,4 @@
-//! Separating half-planes between a straight move of the hull centre and the grown walls (physics.md
+//! Separating half-planes between a straight move of the hull centre and the grown walls (docs/physics.md
 //! section 10): the linearised wall constraints of the optimiser. For a convex grown segment and a move
 //! from `p0` to `p1` apart from it, the line through the closest point of the grown segment, normal to
 //! the closest pair, has the whole grown segment on one side; keeping both ends of the move on the other

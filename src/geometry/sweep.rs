@@ -1,4 +1,4 @@
-//! The player's hull swept through solid walls (physics.md section 10, GoldSrc `PM_FlyMove`).
+//! The player's hull swept through solid walls (docs/physics.md section 10, GoldSrc `PM_FlyMove`).
 //!
 //! [`Corridor::cast`] is one trace: the hull centre is cast as a ray against each solid segment grown by
 //! the box (Cyrus-Beck clipping against its six half-planes), which is the exact time of impact of the
@@ -139,7 +139,7 @@ impl Corridor {
     }
 
     /// One frame's move of the hull centred at `pos` with velocity `vel_ups` for `frame_time_s` seconds,
-    /// against the solid walls (physics.md section 10, GoldSrc `PM_FlyMove` in the air):
+    /// against the solid walls (docs/physics.md section 10, GoldSrc `PM_FlyMove` in the air):
     ///
     /// 1. trace `vel * time_left`; if clear, move and stop;
     /// 2. on a hit at fraction `f`, move to the contact, `time_left -= f * time_left`, clip

@@ -1,5 +1,5 @@
 //! Walls as scenes give them: polylines or polygons in the plane, each a solid wall or a rule boundary
-//! (physics.md section 10), and the shape checks a wall must pass before a [`Corridor`] is built from it.
+//! (docs/physics.md section 10), and the shape checks a wall must pass before a [`Corridor`] is built from it.
 //!
 //! [`Corridor`]: super::Corridor
 
@@ -10,7 +10,7 @@ use parry2d::shape::Segment;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
-/// How a wall constrains the player (physics.md section 10).
+/// How a wall constrains the player (docs/physics.md section 10).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BoundaryKind {

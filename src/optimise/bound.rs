@@ -1,4 +1,4 @@
-//! The lower bound on the finish time (physics.md section 6): the greedy maximum-acceleration speed is the
+//! The lower bound on the finish time (docs/physics.md section 6): the greedy maximum-acceleration speed is the
 //! largest speed any control sequence can have after each frame, so no path can be longer after `n` frames
 //! than the distance the greedy speed profile covers. The time that profile needs to cover the corridor's
 //! shortest path is a lower bound on the time of every run.
@@ -27,7 +27,7 @@ pub struct SpeedBound {
     ground: Option<AccelLaw>,
     friction: Option<(f64, f64)>,
     clamp_speed: Option<f64>,
-    /// `Mx` when the Source jump boost can fire (physics.md section 11).
+    /// `Mx` when the Source jump boost can fire (docs/physics.md section 11).
     jump_boost_maxspeed: Option<f64>,
 }
 
@@ -87,7 +87,7 @@ impl SpeedBound {
     }
 
     /// The largest speed after one airborne frame from any speed up to `speed` (no jump): the clamp, then
-    /// the air FME at maximum acceleration (physics.md sections 6 and 10).
+    /// the air FME at maximum acceleration (docs/physics.md sections 6 and 10).
     fn air_next(&self, speed: f64) -> f64 {
         let s = self.clamp_speed.map_or(speed, |c| speed.min(c));
         self.air.map_or(s, |law| s.max(max_accel(s, law).speed))
@@ -452,7 +452,7 @@ pub struct LowerBound {
     pub crossing: Crossing,
 }
 
-/// The lower bound of `scene` through `corridor` (physics.md section 6). For a `hull` finish the centre
+/// The lower bound of `scene` through `corridor` (docs/physics.md section 6). For a `hull` finish the centre
 /// need only come within the box of the line, at most `16 sqrt 2` units short of it, so that much is
 /// taken off the path. Errors with [`Error::NoValidPath`] when no path reaches the finish.
 pub fn lower_bound(scene: &Scene, corridor: &Corridor) -> Result<LowerBound> {

@@ -1,8 +1,8 @@
-//! The baseline optimiser TAS tools use today (issue 8): random-mutation hill climbing over a plan's
+//! The baseline optimiser TAS tools use today: random-mutation hill climbing over a plan's
 //! per-frame strafe angles.
 //!
 //! A plan is one strafe angle `theta_k` per frame (the angle between the velocity before frame `k` and the
-//! wish direction, physics.md section 5) plus that frame's keys. Each iteration picks a random contiguous
+//! wish direction, docs/physics.md section 5) plus that frame's keys. Each iteration picks a random contiguous
 //! range of frames and either adds one small random offset to their `theta` or flips their side
 //! (`theta -> -theta`), re-simulates the whole run with [`Simulation::run`], and keeps the mutation only if
 //! the run is strictly better: a valid run beats an invalid one, then the earlier crossing wins.

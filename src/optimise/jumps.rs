@@ -1,10 +1,10 @@
-//! The minimal-time plan of a jumping scene (issue 7): accelerated backhopping (ABH) with air strafing,
+//! The minimal-time plan of a jumping scene: accelerated backhopping (ABH) with air strafing,
 //! searched over a family of frame-level policies and checked by exact simulation.
 //!
 //! # Why a policy family is enough
 //!
 //! Every frame of a run in a jumping scene is one of three kinds, and the physics fixes most of each:
-//! 1. **In the air** (physics.md sections 3 and 5) the view acts only through the wish direction. Maximum
+//! 1. **In the air** (docs/physics.md sections 3 and 5) the view acts only through the wish direction. Maximum
 //!    acceleration (section 6) gives the largest speed after every frame whatever the side, so the side is
 //!    free: it is spent on steering. With a strafe key held in Half-Life 2 without the suit (`M = 150`,
 //!    `gamma1 = tau M A = 22.5`, `L = 30`, case 1) a frame adds `gamma1 (2L - gamma1) = 843.75 ups^2` to
@@ -58,7 +58,7 @@ const MAX_STANDING_JUMPS: u32 = 2;
 /// Most ground ticks before a backhop that the search tries.
 const MAX_JUMP_DELAY_TICKS: u32 = 2;
 
-/// How a jump is taken (physics.md section 11).
+/// How a jump is taken (docs/physics.md section 11).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum JumpKind {
@@ -70,7 +70,7 @@ pub enum JumpKind {
 }
 
 /// One candidate run: the choices the search makes (see the module documentation). Every yaw follows from
-/// these and the state by the rules of physics.md sections 6 and 11.
+/// these and the state by the rules of docs/physics.md sections 6 and 11.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct JumpPolicy {
     /// The tick of the first jump (1-based; the first tick on the ground at or after it).
@@ -79,7 +79,7 @@ pub struct JumpPolicy {
     pub first_jump: JumpKind,
     /// Jumps after the first taken standing (forward key) before the ducked backhops start.
     pub standing_jumps: u32,
-    /// Hold forward while the unduck timer runs (the duck crop applies, physics.md section 2).
+    /// Hold forward while the unduck timer runs (the duck crop applies, docs/physics.md section 2).
     pub walk_while_unducking: bool,
     /// On the ground, accelerate at the maximum-acceleration angle (section 6) instead of straight ahead.
     pub ground_strafe: bool,
@@ -166,7 +166,7 @@ impl JumpRunner {
         (-offset / horizon_s.max(MIN_STEER_TIME_S)).clamp(-cap, cap)
     }
 
-    /// The strafing side (physics.md section 6: both sides gain the same speed) that turns the velocity
+    /// The strafing side (docs/physics.md section 6: both sides gain the same speed) that turns the velocity
     /// towards the across-lane speed target of the air steering.
     fn steering_side(&self, s: &PlayerState, origin: Vec2, axis: Vec2) -> Side {
         let normal = axis.perp();
@@ -179,7 +179,7 @@ impl JumpRunner {
         }
     }
 
-    /// A jump tick (physics.md section 11): the boost's signed addition `add` does not depend on the view,
+    /// A jump tick (docs/physics.md section 11): the boost's signed addition `add` does not depend on the view,
     /// so the view is chosen to point `add f` where the boost should go: along the lane, or bent so that
     /// the speed across the lane afterwards returns the hull to the centre line. A strafe key, if held,
     /// is pressed on the side that turns towards that target in the air FME that follows.
@@ -241,7 +241,7 @@ impl JumpRunner {
         }
     }
 
-    /// An airborne tick: maximum acceleration (physics.md section 6) on the side that steers towards the
+    /// An airborne tick: maximum acceleration (docs/physics.md section 6) on the side that steers towards the
     /// across-lane speed target, duck held if the next jump is ducked (released in time for a standing
     /// one: the unduck timer needs `TIME_TO_UNDUCK`, less than a hop).
     fn air_control(&mut self, s: &PlayerState, sim: &Simulation) -> Control {

@@ -1,4 +1,4 @@
-//! The curvature of the convexified sub-step (issue 5): per frame, the Hessian of the Lagrangian of the
+//! The curvature of the convexified sub-step: per frame, the Hessian of the Lagrangian of the
 //! fixed-N problem, projected onto the positive semidefinite matrices.
 //!
 //! The sub-problem maximises progress subject to the frames `x_k = f(x_{k-1}, u_k)` and the walls. The

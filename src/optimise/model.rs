@@ -1,4 +1,4 @@
-//! The frame in planning variables (issue 5; physics.md sections 5 and 6). A frame is described by its side
+//! The frame in planning variables (docs/physics.md sections 5 and 6). A frame is described by its side
 //! `sigma` (wish direction left, +1, or right, -1, of the velocity) and `c = v . a_hat`, the velocity's
 //! projection on the wish direction; `mu` follows from `c` by the law `mu = min(gamma1, L - c)` (0 when
 //! `L <= c`). The state is the position, the speed `V` and the heading `psi`:
@@ -17,7 +17,7 @@
 
 use crate::physics::{AccelLaw, Control, Vec2};
 
-/// One anglemod step of the yaw, radians (physics.md section 1: `360 / 65536` degrees).
+/// One anglemod step of the yaw, radians (docs/physics.md section 1: `360 / 65536` degrees).
 const ANGLEMOD_STEP_RAD: f64 = std::f64::consts::TAU / 65536.0;
 use std::ops::{Add, Div, Mul, Sub};
 
@@ -33,7 +33,7 @@ pub struct FrameLaw {
 }
 
 impl FrameLaw {
-    /// The `c` of maximum acceleration at speed `v` (physics.md section 6): `min(L - gamma1, V)` in case 1,
+    /// The `c` of maximum acceleration at speed `v` (docs/physics.md section 6): `min(L - gamma1, V)` in case 1,
     /// 0 in case 2. Larger `c` gains less speed and turns less, so it is the upper bound of `c`.
     pub fn c_max(&self, v: f64) -> f64 {
         let AccelLaw { l, gamma1 } = self.law;
@@ -45,7 +45,7 @@ impl FrameLaw {
     }
 
     /// The largest `c` a plan uses at speed `v`, ups: [`FrameLaw::c_max`], less half an anglemod step of
-    /// the strafe angle (`V q / 2`, `q = 2 pi / 65536`, physics.md section 1) in case 1. There `c_max` is
+    /// the strafe angle (`V q / 2`, `q = 2 pi / 65536`, docs/physics.md section 1) in case 1. There `c_max` is
     /// the law's kink, and the game's yaw, on anglemod steps, puts the real `c` up to half a step either
     /// side of the planned one: above the kink `mu = L - c` drops below `gamma1`, below it `c` is smaller,
     /// and either way every frame gains less than a plan on the kink. Over thousands of frames (1000 fps)
@@ -400,7 +400,7 @@ fn frame_outputs<T: Ad>(x: &ModelState, u: FrameControl, fl: &FrameLaw, frames: 
 /// One frame over [`Ad`] numbers: `(dx, dy, V', psi')` from `(V, psi)` and the control `(c, sigma)`.
 fn one_frame<T: Ad>(v: T, psi: T, c: T, sigma: T, fl: &FrameLaw) -> [T; 4] {
     let AccelLaw { l, gamma1 } = fl.law;
-    // mu = min(gamma1, L - c) when L - c > 0, else 0 (physics.md section 5); the piece is fixed by value.
+    // mu = min(gamma1, L - c) when L - c > 0, else 0 (docs/physics.md section 5); the piece is fixed by value.
     let gamma2 = T::constant(l) - c;
     let mu = if gamma2.value() <= 0.0 {
         T::constant(0.0)
@@ -521,7 +521,7 @@ pub fn rollout_knots(
 }
 
 /// The game control that realises `(sigma = +-1, c)` from a velocity `vel`: the strafe angle
-/// `theta = sigma acos(c / |v|)` with full sidemove (physics.md section 5).
+/// `theta = sigma acos(c / |v|)` with full sidemove (docs/physics.md section 5).
 pub fn control_for(vel: Vec2, u: FrameControl, fl: &FrameLaw) -> Control {
     let speed = vel.length();
     let cos_theta = if speed > 0.0 {

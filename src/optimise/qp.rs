@@ -1,4 +1,4 @@
-//! The convexified sub-step (issue 5): the dynamics linearised around the current trajectory, the walls as
+//! The convexified sub-step: the dynamics linearised around the current trajectory, the walls as
 //! separating half-planes, a trust region, and slack so that every sub-problem is feasible. Solved by
 //! Clarabel as `min 0.5 z'Pz + q'z  s.t.  Az + s = b, s in K`.
 //!

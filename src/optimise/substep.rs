@@ -1,4 +1,4 @@
-//! One convexified sub-step set up from a scene, for benchmarks and tests (issue 8): the greedy run in
+//! One convexified sub-step set up from a scene, for benchmarks and tests: the greedy run in
 //! planning variables, linearised frame by frame, its walls as separating half-planes, and a trust region
 //! around it, in the shape [`qp::solve`] takes. It mirrors the first relaxed iteration of
 //! [`super::search`] without running the search.

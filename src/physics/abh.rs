@@ -1,4 +1,4 @@
-//! The accelerated-backhop article's model (physics.md section 11): each hop lasts a fixed time at constant
+//! The accelerated-backhop article's model (docs/physics.md section 11): each hop lasts a fixed time at constant
 //! speed, and each backhop's jump boost maps `|v|` to `2|v| - 1.1 Mx`, clamped to `sv_maxvelocity`.
 
 use super::real::Real;
@@ -26,7 +26,7 @@ pub struct AbhArticle {
     pub landing_past_line: f64,
 }
 
-/// The boost's signed addition along the view, ups (physics.md section 11), for the effective forwardmove
+/// The boost's signed addition along the view, ups (docs/physics.md section 11), for the effective forwardmove
 /// `fm`, `p` (0.1 ducked or sprinting, else 0.5), max speed `mx` and horizontal speed `speed`:
 /// `add = |Fm p|`, cut so the new speed does not pass `Mx (1 + p)`, negated for a backwards key. Written
 /// once over [`Real`] for the frame step (`f64` and `f32`), the frame-level planners and the article's
@@ -68,7 +68,7 @@ pub fn boost_add_from_keys<R: Real>(
     boost_add(fm, p, mx, speed)
 }
 
-/// Speed after a jump with the Source boost (physics.md section 11) for forwardmove `fm` along the view,
+/// Speed after a jump with the Source boost (docs/physics.md section 11) for forwardmove `fm` along the view,
 /// speed `speed` along the view's axis, `p = 0.1` ducked or sprinting else `0.5`, max speed `mx`.
 /// Facing backwards, `fm = 0`, ducked: `2|v| - 1.1 Mx` when `|v| > 1.1 Mx`.
 pub fn boosted_speed(speed: f64, fm: f64, p: f64, mx: f64, facing_backwards: bool) -> f64 {
@@ -80,7 +80,7 @@ pub fn boosted_speed(speed: f64, fm: f64, p: f64, mx: f64, facing_backwards: boo
     }
 }
 
-/// The article's run (physics.md section 11): walking at `max_speed`, a forward jump (`p = 0.5`,
+/// The article's run (docs/physics.md section 11): walking at `max_speed`, a forward jump (`p = 0.5`,
 /// `Fm = Mx`) gives `1.5 Mx`; then each ducked backhop (`Fm = 0`, `p = 0.1`) doubles the excess over
 /// `1.1 Mx`, clamped to `max_velocity`; each hop lasts `hop_time_s` at constant speed. The table runs until
 /// the hop in which `distance_units` is crossed.

@@ -1,4 +1,4 @@
-//! Speeds and frame counts in closed form (physics.md sections 4 and 6), and the same figures by stepping
+//! Speeds and frame counts in closed form (docs/physics.md sections 4 and 6), and the same figures by stepping
 //! the frame, so each closed form can be checked against the game's own recurrence.
 
 use super::effects::{Effect, Effects};
@@ -8,7 +8,7 @@ use super::vars::MovementVars;
 use super::vec2::Vec2;
 use crate::error::{Error, Result};
 
-/// Speed after `n` frames of maximum-acceleration airstrafing from `v0` (physics.md section 6, no
+/// Speed after `n` frames of maximum-acceleration airstrafing from `v0` (docs/physics.md section 6, no
 /// friction): linear growth `v0 + n gamma1` while `|v| <= L - gamma1` (case 1, `cos Theta = 1`), then
 /// `sqrt(v^2 + n gamma1 (2L - gamma1))` (case 1) or `sqrt(v^2 + n L^2)` (case 2). `n` may be fractional.
 pub fn airstrafe_speed_after(v0: f64, n: f64, law: AccelLaw) -> f64 {
@@ -38,7 +38,7 @@ fn linear_phase(v0: f64, n: f64, law: AccelLaw) -> (f64, f64) {
     }
 }
 
-/// Frames of maximum-acceleration airstrafing from `v0` to `v1` ups, by the closed form of physics.md
+/// Frames of maximum-acceleration airstrafing from `v0` to `v1` ups, by the closed form of docs/physics.md
 /// section 6 (fractional: the frame in which `v1` is reached is its ceiling). `None` when the law cannot
 /// accelerate.
 ///
@@ -73,7 +73,7 @@ pub fn airstrafe_frames_to_speed(v0: f64, v1: f64, law: AccelLaw) -> Option<f64>
     Some((v1 * v1 - v0 * v0) / per_frame)
 }
 
-/// Frames of maximum-acceleration groundstrafing from `v0` to `v1` ups under geometric friction (physics.md
+/// Frames of maximum-acceleration groundstrafing from `v0` to `v1` ups under geometric friction (docs/physics.md
 /// sections 4 and 6, case 1 with `cos zeta < 1`): `w = |v|^2` obeys `w' = a w + b` with
 /// `a = (1 - tau k)^2`, `b = gamma1 (2L - gamma1)`, so `n = ln((w1 - w*)/(w0 - w*)) / ln a` with
 /// `w* = b/(1 - a)`. `None` outside that regime (below `sv_stopspeed`, case 2, or at or above the
@@ -107,7 +107,7 @@ pub fn groundstrafe_frames_to_speed(
     Some(((w1 - w_star) / (w0 - w_star)).ln() / a.ln())
 }
 
-/// The steady groundstrafe speed, ups, where maximum acceleration exactly cancels friction (physics.md
+/// The steady groundstrafe speed, ups, where maximum acceleration exactly cancels friction (docs/physics.md
 /// sections 6 and 12): `M sqrt(k_e A (2 - tau k_e A) / (k (2 - tau k)))` in case 1 with geometric
 /// friction, `L / sqrt(1 - (1 - tau k)^2)` in case 2, and `(d^2 + b)/(2 d)` (`d = tau E k`) when the
 /// steady state lies in the arithmetic branch below `sv_stopspeed`. Infinite without friction.
@@ -163,7 +163,7 @@ pub fn strafing_effects(ground: bool, edge_friction: bool) -> Effects {
 }
 
 /// Frames to strafe from `v0` to `v1` by stepping the frame with the maximum-acceleration angle every
-/// frame (the whole frame of physics.md section 3, with the velocity clamp). Errors when the speed stops
+/// frame (the whole frame of docs/physics.md section 3, with the velocity clamp). Errors when the speed stops
 /// growing before `v1` or `max_frames` pass.
 pub fn frames_to_speed_by_stepping(
     vars: &MovementVars,

@@ -1,4 +1,4 @@
-//! Curvature and the radius-speed relation (physics.md section 9).
+//! Curvature and the radius-speed relation (docs/physics.md section 9).
 //!
 //! Two radii are kept apart on purpose. The source text's relation
 //! `r = (tau / sin theta)(2|v|^2/mu + 3|v| cos theta + mu)` gives about twice the radius of the path the
@@ -16,12 +16,12 @@ use crate::error::{Error, Result};
 pub const HULL_WIDTH_UNITS: f64 = 32.0;
 
 /// Largest arc through a 90-degree bend of equal width `d` before and after, touching both outer walls and
-/// the inner corner: `r = (2 + sqrt 2) d` (physics.md section 9). Pass the width left for the hull centre.
+/// the inner corner: `r = (2 + sqrt 2) d` (docs/physics.md section 9). Pass the width left for the hull centre.
 pub fn bend_arc_radius(width_for_centre: f64) -> f64 {
     (2.0 + std::f64::consts::SQRT_2) * width_for_centre
 }
 
-/// The source text's radius of the path over one frame (physics.md section 9):
+/// The source text's radius of the path over one frame (docs/physics.md section 9):
 /// `r = (tau / sin theta)(2|v|^2/mu + 3|v| cos theta + mu)`. Infinite when `sin theta` or `mu` is zero.
 pub fn radius_source_text(speed: f64, cos_theta: f64, mu: f64, tau_s: f64) -> f64 {
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
@@ -31,7 +31,7 @@ pub fn radius_source_text(speed: f64, cos_theta: f64, mu: f64, tau_s: f64) -> f6
     (tau_s / sin_theta) * (2.0 * speed * speed / mu + 3.0 * speed * cos_theta + mu)
 }
 
-/// The first-order radius of the discrete path (physics.md section 9): the velocity turns by about
+/// The first-order radius of the discrete path (docs/physics.md section 9): the velocity turns by about
 /// `mu sin theta / |v'|` per frame over a chord of `tau |v'|`, so `r = tau |v'|^2 / (mu sin theta)`.
 pub fn radius_first_order(speed_after: f64, cos_theta: f64, mu: f64, tau_s: f64) -> f64 {
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
@@ -76,7 +76,7 @@ pub struct MaxAccelRadii {
     pub measured: f64,
 }
 
-/// The radii of maximum-acceleration airstrafing at `speed` (physics.md section 9).
+/// The radii of maximum-acceleration airstrafing at `speed` (docs/physics.md section 9).
 ///
 /// # Example
 /// At 500 ups and 100 fps (theta = 90 degrees) the relation gives 167 units, the game draws 83.8:

@@ -1,10 +1,10 @@
-//! The effects a scene can ask for (physics.md section 3). The frame step runs only those a scene names:
+//! The effects a scene can ask for (docs/physics.md section 3). The frame step runs only those a scene names:
 //! a purely airborne scene pays nothing for friction, gravity or jumps.
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
-/// One effect of the frame (physics.md section 3), as named in scene files.
+/// One effect of the frame (docs/physics.md section 3), as named in scene files.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Effect {
@@ -66,7 +66,7 @@ impl Effect {
     }
 
     /// The effects this one needs (`jump` needs `gravity`). The Source jump boost also needs the
-    /// velocity clamp: backhops double the excess speed every hop (physics.md section 11), and only
+    /// velocity clamp: backhops double the excess speed every hop (docs/physics.md section 11), and only
     /// `sv_maxvelocity` stops that reaching infinity.
     pub fn requires(self) -> &'static [Effect] {
         match self {
@@ -145,7 +145,7 @@ impl Effects {
     }
 
     /// True when only air acceleration, the velocity clamp and walls are asked for: the frame is then just
-    /// steps 4 and 5 of physics.md section 3.
+    /// steps 4 and 5 of docs/physics.md section 3.
     #[inline]
     pub const fn is_air_only(self) -> bool {
         let air = Effect::AirAccel.bit() | Effect::MaxVelocity.bit() | Effect::Walls.bit();

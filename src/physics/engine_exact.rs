@@ -1,4 +1,4 @@
-//! The engine-exact mode (physics.md section 1): the state in `f32` as the game keeps it, and the yaw sent
+//! The engine-exact mode (docs/physics.md section 1): the state in `f32` as the game keeps it, and the yaw sent
 //! through *anglemod*, `A_d(x) = (360/65536) (int(x 65536/360) AND 65535)` degrees, before the view vectors
 //! are computed. The frame logic is the very same [`Stepper`], run over `f32`.
 //!
@@ -14,7 +14,7 @@ use serde::Serialize;
 /// Number of anglemod steps in a full turn.
 pub const ANGLEMOD_STEPS: u32 = 65536;
 
-/// The game's anglemod of a yaw in degrees (physics.md section 1): the angle truncated towards zero to a
+/// The game's anglemod of a yaw in degrees (docs/physics.md section 1): the angle truncated towards zero to a
 /// multiple of `360/65536` degrees and wrapped into `[0, 360)`. Computed as the game does: the `float`
 /// argument promoted to `double`, the result stored as `float`.
 pub fn anglemod_deg(yaw_deg: f32) -> f32 {

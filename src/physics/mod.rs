@@ -1,4 +1,4 @@
-//! Movement physics: the per-frame dynamics of physics.md, with no I/O and no geometry.
+//! Movement physics: the per-frame dynamics of docs/physics.md, with no I/O and no geometry.
 //!
 //! - [`vars`]: movement variables and presets (section 2).
 //! - [`effects`]: which parts of the frame a scene runs (section 3).

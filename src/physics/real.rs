@@ -1,5 +1,5 @@
 //! The scalar the frame step is written over: `f64` for planning, `f32` for the engine-exact mode
-//! (physics.md section 1: the game itself computes in `float`). One step implementation serves both, so
+//! (docs/physics.md section 1: the game itself computes in `float`). One step implementation serves both, so
 //! the two arithmetics can never drift apart in logic, only in rounding.
 
 use std::fmt::Debug;

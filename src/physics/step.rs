@@ -1,4 +1,4 @@
-//! One simulation frame (physics.md section 3, GoldSrc `PM_PlayerMove` / Source `FullWalkMove` order):
+//! One simulation frame (docs/physics.md section 3, GoldSrc `PM_PlayerMove` / Source `FullWalkMove` order):
 //! duck, first half of gravity, jump, friction, clamp, the FME, the move, categorisation, second half of
 //! gravity. The step is written once over the scalar `R` ([`Real`]): `f64` plans, `f32` reproduces the
 //! game's own arithmetic (see `engine_exact`).
@@ -35,13 +35,13 @@ pub struct PlayerState<R = f64> {
     pub unduck_elapsed_s: R,
 }
 
-/// Hull height standing, units (physics.md section 2).
+/// Hull height standing, units (docs/physics.md section 2).
 pub const HULL_HEIGHT_STANDING_UNITS: f64 = 72.0;
 /// Hull height ducked, units.
 pub const HULL_HEIGHT_DUCKED_UNITS: f64 = 36.0;
 
 impl<R: Real> PlayerState<R> {
-    /// The hull's height by duck state, units: 72 standing, 36 ducked (physics.md section 2).
+    /// The hull's height by duck state, units: 72 standing, 36 ducked (docs/physics.md section 2).
     #[inline]
     pub fn hull_height_units(&self) -> f64 {
         if self.ducked {
@@ -92,7 +92,7 @@ impl PlayerState<f64> {
 
 /// What the player does in one frame, after the view angles are turned into vectors: the unit forward view
 /// vector flattened to the plane (`f = (cos yaw, sin yaw)`), forwardmove `F` and sidemove `S` in ups, and the
-/// buttons. The right vector is `s = (sin yaw, -cos yaw)` (physics.md section 1).
+/// buttons. The right vector is `s = (sin yaw, -cos yaw)` (docs/physics.md section 1).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Wish<R = f64> {
     /// Unit forward view vector in the plane.
@@ -158,7 +158,7 @@ impl Control {
 
     /// The convenience form: strafe at angle `theta_rad` between the velocity `vel` and the wish direction
     /// (positive turns left), holding the keys `forwardmove`, `sidemove`. The yaw is chosen so that
-    /// `a_hat = R(theta) v_hat` (physics.md section 5): `yaw = angle(v) + theta + atan2(S, F)`. At zero
+    /// `a_hat = R(theta) v_hat` (docs/physics.md section 5): `yaw = angle(v) + theta + atan2(S, F)`. At zero
     /// velocity the direction is lost and `theta` is taken from `heading_rad` instead.
     pub fn strafe(
         vel: Vec2,
@@ -193,7 +193,7 @@ impl Control {
     }
 }
 
-/// Per-frame constants of the FME (physics.md section 5): `L` and `gamma1 = k_e tau M A`.
+/// Per-frame constants of the FME (docs/physics.md section 5): `L` and `gamma1 = k_e tau M A`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AccelLaw<R = f64> {
     /// `L`: `M` on the ground, `min(30, M)` in the air, ups.
@@ -203,7 +203,7 @@ pub struct AccelLaw<R = f64> {
 }
 
 impl AccelLaw<f64> {
-    /// The air law for wish speed `m` ups (physics.md section 5): `L = min(30, M)`,
+    /// The air law for wish speed `m` ups (docs/physics.md section 5): `L = min(30, M)`,
     /// `gamma1 = k_e tau M A_air`.
     pub fn air(vars: &MovementVars, m: f64) -> Self {
         AccelLaw {
@@ -222,7 +222,7 @@ impl AccelLaw<f64> {
 }
 
 impl<R: Real> AccelLaw<R> {
-    /// `mu = min(gamma1, gamma2)` if `gamma2 = L - lambda(v).a_hat > 0`, else 0 (physics.md section 5), given
+    /// `mu = min(gamma1, gamma2)` if `gamma2 = L - lambda(v).a_hat > 0`, else 0 (docs/physics.md section 5), given
     /// `c = lambda(v).a_hat`.
     #[inline]
     pub fn mu(&self, c: R) -> R {
@@ -316,7 +316,7 @@ impl<R: Real> Stepper<R> {
         s.pos += s.vel * self.tau;
     }
 
-    /// Steps 1-4 of physics.md section 3: everything before the position update.
+    /// Steps 1-4 of docs/physics.md section 3: everything before the position update.
     #[inline]
     pub fn pre_move(&self, s: &mut PlayerState<R>, w: &Wish<R>) {
         if let Some((a_hat, law)) = self.prepare(s, w) {
@@ -329,7 +329,7 @@ impl<R: Real> Stepper<R> {
     }
 
     /// Steps 1-3 and the clamp of step 4: duck, gravity, jump, friction. Afterwards `s.vel` is `lambda(v)`.
-    /// Returns the wish direction and the acceleration law (physics.md section 5) when an acceleration
+    /// Returns the wish direction and the acceleration law (docs/physics.md section 5) when an acceleration
     /// effect applies this frame. The law does not depend on the view direction, so a controller can call
     /// this on a copy of the state to choose its angle from `lambda(v)`.
     #[inline]
@@ -361,7 +361,7 @@ impl<R: Real> Stepper<R> {
         }
     }
 
-    /// Steps 5 (vertical part) and 6 of physics.md section 3: the vertical move onto the flat floor, ground
+    /// Steps 5 (vertical part) and 6 of docs/physics.md section 3: the vertical move onto the flat floor, ground
     /// categorisation and the second half of gravity. Call after the horizontal move.
     pub fn post_move(&self, s: &mut PlayerState<R>) {
         if !self.effects.has(Effect::Gravity) {
@@ -385,7 +385,7 @@ impl<R: Real> Stepper<R> {
         }
     }
 
-    /// `L` and `gamma1` in the air for wish speed `m` (physics.md section 5).
+    /// `L` and `gamma1` in the air for wish speed `m` (docs/physics.md section 5).
     #[inline]
     pub fn air_law(&self, m: R) -> AccelLaw<R> {
         AccelLaw {
@@ -404,7 +404,7 @@ impl<R: Real> Stepper<R> {
     }
 
     /// The unit wish direction `a_hat = (F f + S s)/sqrt(F^2+S^2)` and wish speed `M = min(M_m, |(F, S)|)`
-    /// (physics.md section 2), with the duck multiplier where it applies. Zero keys give `M = 0`.
+    /// (docs/physics.md section 2), with the duck multiplier where it applies. Zero keys give `M = 0`.
     #[inline]
     pub fn wish_direction(&self, w: &Wish<R>, ducked: bool, on_ground: bool) -> (V2<R>, R) {
         let (mut fm, mut sm) = (w.forwardmove, w.sidemove);
@@ -484,7 +484,7 @@ impl<R: Real> Stepper<R> {
         }
     }
 
-    /// The Source jump boost (physics.md section 11); the duck crop applies when the duck effect runs.
+    /// The Source jump boost (docs/physics.md section 11); the duck crop applies when the duck effect runs.
     fn jump_boost(&self, s: &mut PlayerState<R>, w: &Wish<R>) {
         let crop = if self.effects.has(Effect::Duck) {
             self.duck_multiplier
@@ -519,7 +519,7 @@ impl<R: Real> Stepper<R> {
     }
 }
 
-/// Ground friction `lambda(v)` (physics.md section 4) with `k = sv_friction k_e e_f`, `E = sv_stopspeed`:
+/// Ground friction `lambda(v)` (docs/physics.md section 4) with `k = sv_friction k_e e_f`, `E = sv_stopspeed`:
 /// geometric above `E`, arithmetic below, zero once the drop exceeds the speed. Below 0.1 ups the game
 /// leaves the velocity alone (`PM_Friction`: `if (speed < 0.1) return`), and so do we.
 #[inline]
@@ -534,7 +534,7 @@ pub fn friction<R: Real>(vel: V2<R>, tau: R, k: R, stopspeed: R) -> V2<R> {
     vel * (new_speed / speed)
 }
 
-/// The FME (physics.md section 5): `v' = lambda(v) + mu a_hat`, `mu = min(gamma1, L - v.a_hat)` when
+/// The FME (docs/physics.md section 5): `v' = lambda(v) + mu a_hat`, `mu = min(gamma1, L - v.a_hat)` when
 /// positive, else no change. `vel` is already `lambda(v)`.
 #[inline]
 pub fn accelerate<R: Real>(vel: V2<R>, a_hat: V2<R>, law: AccelLaw<R>) -> V2<R> {
@@ -625,7 +625,7 @@ mod tests {
 
     #[test]
     fn jump_airtime_matches_the_two_unit_layer_formula() {
-        // physics.md section 10: t = (2/g)(60 sqrt 5 + sqrt(18000 - g)) = 0.663 s at g = 800.
+        // docs/physics.md section 10: t = (2/g)(60 sqrt 5 + sqrt(18000 - g)) = 0.663 s at g = 800.
         let vars = MovementVars::goldsrc(1000.0);
         let fx = Effects::from_list(&[Effect::Gravity, Effect::Jump]);
         let st: Stepper<f64> = Stepper::new(&vars, fx);
@@ -689,7 +689,7 @@ mod tests {
 
     #[test]
     fn source_backhop_boost_gives_two_v_minus_cap() {
-        // physics.md section 11: ducked, facing backwards, no keys: v -> 2|v| - 1.1 Mx.
+        // docs/physics.md section 11: ducked, facing backwards, no keys: v -> 2|v| - 1.1 Mx.
         let mut vars = MovementVars::source_hl2(66.666_666_666_666_67);
         vars.maxspeed = 150.0;
         let fx = Effects::from_list(&[

@@ -1,4 +1,4 @@
-//! Strafe angles (physics.md sections 5-8). Every function takes `lambda = |lambda(v)|`, the speed after
+//! Strafe angles (docs/physics.md sections 5-8). Every function takes `lambda = |lambda(v)|`, the speed after
 //! friction (ups), and the frame's [`AccelLaw`] (`L`, `gamma1`), and works with `cos theta`, where `theta`
 //! is the angle between `lambda(v)` and the wish direction. Speeds depend only on `cos theta`; the sign of
 //! `theta` picks the side. No function divides by a zero speed or takes `acos` of an unclamped value.
@@ -6,7 +6,7 @@
 use super::step::{AccelLaw, Control, PlayerState, Side, Stepper, Wish};
 use super::vec2::Vec2;
 
-/// Speed after one frame at `cos theta` (the scalar FME, physics.md section 5):
+/// Speed after one frame at `cos theta` (the scalar FME, docs/physics.md section 5):
 /// `|v'|^2 = lambda^2 + mu^2 + 2 mu lambda cos theta` with `mu = min(gamma1, L - lambda cos theta)` when
 /// `L - lambda cos theta > 0`, else 0.
 #[inline]
@@ -16,7 +16,7 @@ pub fn speed_after(lambda: f64, cos_theta: f64, law: AccelLaw) -> f64 {
     (lambda * lambda + mu * mu + 2.0 * mu * c).max(0.0).sqrt()
 }
 
-/// `mu` at `cos theta` (physics.md section 5).
+/// `mu` at `cos theta` (docs/physics.md section 5).
 #[inline]
 pub fn mu_at(lambda: f64, cos_theta: f64, law: AccelLaw) -> f64 {
     law.mu(lambda * cos_theta)
@@ -28,7 +28,7 @@ pub fn theta_from_cos(cos_theta: f64) -> f64 {
     cos_theta.clamp(-1.0, 1.0).acos()
 }
 
-/// Which case of physics.md section 6 a frame falls in.
+/// Which case of docs/physics.md section 6 a frame falls in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MaxAccelCase {
     /// `gamma1 >= 0`, `L - gamma1 >= 0`, `L >= 0`: `cos Theta = min(1, cos zeta)`.
@@ -46,7 +46,7 @@ pub enum MaxAccelCase {
 /// The maximum-acceleration choice of one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MaxAccel {
-    /// The case of physics.md section 6.
+    /// The case of docs/physics.md section 6.
     pub case: MaxAccelCase,
     /// The optimal `cos Theta` (for cases 3 and 4, where a range is optimal, 1: keep the heading).
     pub cos_theta: f64,
@@ -54,7 +54,7 @@ pub struct MaxAccel {
     pub speed: f64,
 }
 
-/// Maximum acceleration (physics.md section 6, all five cases). `lambda` may be zero: the direction is then
+/// Maximum acceleration (docs/physics.md section 6, all five cases). `lambda` may be zero: the direction is then
 /// lost and `cos Theta` refers to the view direction. `cos zeta = (L - gamma1)/lambda` and
 /// `cos zeta_bar = L/lambda` are compared by multiplying through by `lambda`, never divided by zero.
 pub fn max_accel(lambda: f64, law: AccelLaw) -> MaxAccel {
@@ -105,7 +105,7 @@ pub fn max_accel(lambda: f64, law: AccelLaw) -> MaxAccel {
     }
 }
 
-/// The maximum-acceleration angle `Theta` in `[0, pi]`, radians (physics.md section 6).
+/// The maximum-acceleration angle `Theta` in `[0, pi]`, radians (docs/physics.md section 6).
 #[inline]
 pub fn max_accel_theta(lambda: f64, law: AccelLaw) -> f64 {
     theta_from_cos(max_accel(lambda, law).cos_theta)
@@ -129,7 +129,7 @@ fn extremum_candidates(lambda: f64, law: AccelLaw) -> Vec<f64> {
     c
 }
 
-/// Maximum deceleration (physics.md section 7): the `cos theta` that minimises the new speed, and that
+/// Maximum deceleration (docs/physics.md section 7): the `cos theta` that minimises the new speed, and that
 /// speed. In the common case (`gamma1 >= 0`, `L >= 0`, `L - gamma1 >= 0`) it is `cos theta = -1`, giving
 /// `| lambda - gamma1 |`; in general the minimum is found exactly among the piece boundaries.
 pub fn max_decel(lambda: f64, law: AccelLaw) -> (f64, f64) {
@@ -143,7 +143,7 @@ pub fn max_decel(lambda: f64, law: AccelLaw) -> (f64, f64) {
     best
 }
 
-/// Speed-preserving strafing (physics.md section 8): the `cos theta` at which the speed after the frame
+/// Speed-preserving strafing (docs/physics.md section 8): the `cos theta` at which the speed after the frame
 /// equals `speed_before` (the speed before friction; equal to `lambda` without friction), turning as hard as
 /// possible (the smallest such `cos theta`), or `None` when no angle preserves it (then fall back to
 /// [`max_accel`], as section 8 says).
@@ -193,7 +193,7 @@ pub fn speed_preserving_cos_theta(speed_before: f64, lambda: f64, law: AccelLaw)
         })
 }
 
-/// The sharpest turn of one frame (physics.md section 9): the `theta` in `[0, pi]` that turns the velocity
+/// The sharpest turn of one frame (docs/physics.md section 9): the `theta` in `[0, pi]` that turns the velocity
 /// furthest, and that turn, radians. The turn at `theta` is `atan2(mu sin theta, lambda + mu cos theta)`.
 /// Where `mu = gamma1` it peaks at `cos theta = -gamma1/lambda`; where `mu = gamma2` it is found by a scan
 /// refined by golden-section search.
@@ -248,7 +248,7 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
 
 /// The maximum-acceleration control of this frame for a player holding the keys `forwardmove`, `sidemove`,
 /// turning to `side`: the stepper's own friction and law are applied to a copy of the state, then the yaw is
-/// set so that the wish direction makes the angle [`max_accel_theta`] with `lambda(v)` (physics.md
+/// set so that the wish direction makes the angle [`max_accel_theta`] with `lambda(v)` (docs/physics.md
 /// section 6). `heading_rad` is used at zero speed. The returned control carries the given buttons.
 pub fn max_accel_control(
     stepper: &Stepper<f64>,

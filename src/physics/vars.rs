@@ -1,4 +1,4 @@
-//! Movement variables (physics.md section 2): the server settings and client constants one frame of
+//! Movement variables (docs/physics.md section 2): the server settings and client constants one frame of
 //! movement depends on, with the Half-Life and Half-Life 2 defaults as presets.
 
 use crate::error::{require_finite, require_non_negative, require_positive, Error, Result};
@@ -14,7 +14,7 @@ pub enum Game {
     Source,
 }
 
-/// A named set of defaults (physics.md section 2).
+/// A named set of defaults (docs/physics.md section 2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Preset {
     /// Half-Life defaults: `sv_maxspeed 320`, `sv_accelerate 10`, `sv_airaccelerate 10`, `sv_friction 4`,
@@ -55,7 +55,7 @@ pub const SOURCE_JUMP_HEIGHT_UNITS: f64 = 21.0;
 pub const BHOP_CAP_FACTOR: f64 = 1.7;
 /// Speed after the bunnyhop cap, a multiple of `sv_maxspeed` (`1.7 * 0.65`).
 pub const BHOP_CAP_RESULT_FACTOR: f64 = 1.105;
-/// Above this vertical speed (ups) the player is never on the ground (physics.md section 3, step 6).
+/// Above this vertical speed (ups) the player is never on the ground (docs/physics.md section 3, step 6).
 pub const GROUND_MAX_VZ_UPS: f64 = 180.0;
 /// The ground layer: within this height (units) above a floor the player stands on it.
 pub const GROUND_LAYER_UNITS: f64 = 2.0;
@@ -73,7 +73,7 @@ pub const MIN_FPS: f64 = 1.0;
 /// six million frames).
 pub const MAX_FPS: f64 = 1e5;
 
-/// The movement variables of physics.md section 2, in ups, ups^2, seconds.
+/// The movement variables of docs/physics.md section 2, in ups, ups^2, seconds.
 ///
 /// Build one from a [`Preset`] and change any field through [`VarOverrides`], which validates.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -170,7 +170,7 @@ impl MovementVars {
         Self::preset(Preset::SourceHl2, fps)
     }
 
-    /// The frame time `tau`, seconds (physics.md section 1).
+    /// The frame time `tau`, seconds (docs/physics.md section 1).
     #[inline]
     pub fn frame_time_s(&self) -> f64 {
         let tau = 1.0 / self.fps;
@@ -190,7 +190,7 @@ impl MovementVars {
         }
     }
 
-    /// Ground friction constant `k = sv_friction * k_e * e_f` (physics.md section 2); `edge` applies `e_f`.
+    /// Ground friction constant `k = sv_friction * k_e * e_f` (docs/physics.md section 2); `edge` applies `e_f`.
     #[inline]
     pub fn friction_k(&self, edge: bool) -> f64 {
         let ef = if edge { self.edgefriction } else { 1.0 };

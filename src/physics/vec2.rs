@@ -1,4 +1,4 @@
-//! A plain 2-D vector in the horizontal plane (physics.md section 1), in world units or ups.
+//! A plain 2-D vector in the horizontal plane (docs/physics.md section 1), in world units or ups.
 
 use super::real::Real;
 use serde::{Deserialize, Serialize};
@@ -106,7 +106,7 @@ impl Vec2 {
         self.y.atan2(self.x)
     }
 
-    /// Rotated anticlockwise by `angle_rad` (the rotation R(theta) of physics.md section 5; our positive
+    /// Rotated anticlockwise by `angle_rad` (the rotation R(theta) of docs/physics.md section 5; our positive
     /// angles turn left, anticlockwise, the way the game's yaw grows).
     #[inline]
     pub fn rotated(self, angle_rad: f64) -> Self {

@@ -1,16 +1,18 @@
-//! The report's four SVG figures, drawn with plotters' SVG backend (no fonts are loaded: text is left to
+//! The report's five SVG figures, drawn with plotters' SVG backend (no fonts are loaded: text is left to
 //! the browser). Each function returns one `<svg>` element as text. Long runs are thinned to at most
 //! [`MAX_POINTS_PER_SERIES`] points per line so a 40 000-frame run stays a small file; the thinning keeps
 //! the first and last points and is deterministic.
 
-use super::html::ReportInput;
+use super::html::{ReportInput, ReportRun};
 use crate::geometry::{BoundaryKind, HULL_HALF_WIDTH_UNITS};
 use crate::optimise::bound::SpeedBound;
 use crate::physics::curvature::{circumradius, max_accel_radii};
-use crate::physics::Vec2;
+use crate::physics::{MovementVars, Vec2};
 use crate::sim::{FrameRecord, Trace};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::error::Error as StdError;
 use std::io;
 
@@ -148,10 +150,23 @@ fn end_time(input: &ReportInput) -> f64 {
         .max(input.scene.frame_time_s())
 }
 
-/// Figure 1: the corridor, to scale: solid walls (black), rule lines (orange, dashed), the finish line
-/// (green), the lower bound's shortest path (grey, dashed), each run's path with the 32 x 32 hull at a few
-/// frames, and a red cross at each run's first rule violation and first wall contact.
-pub fn corridor_svg(input: &ReportInput) -> io::Result<String> {
+/// A chart over `f64 x f64` data coordinates on the SVG backend.
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The corridor figure's layout: the data range shown, pixels per unit along each axis, the figure's
+/// height and its title.
+#[derive(Clone, Debug)]
+struct CorridorLayout {
+    x: (f64, f64),
+    y: (f64, f64),
+    px_per_x: f64,
+    px_per_y: f64,
+    height_px: u32,
+    title: String,
+}
+
+/// Everything the corridor figure shows: walls, the finish line, the bound's shortest path, each run.
+fn corridor_extent(input: &ReportInput) -> Extent {
     let scene = input.scene;
     let mut ext = Extent::new();
     for w in &scene.walls {
@@ -163,10 +178,15 @@ pub fn corridor_svg(input: &ReportInput) -> io::Result<String> {
     for run in &input.runs {
         records(run.trace).for_each(|r| ext.add(r.pos));
     }
-    let (mut x0, mut x1, mut y0, mut y1) = ext.padded(2.5 * HULL_HALF_WIDTH_UNITS);
-    // One unit is the same length across and up: fit the plot area to the data's aspect, then widen the
-    // shorter range to fill it. A corridor more than CORRIDOR_MAX_ASPECT times longer than wide (a 100 m
-    // lane) would be a hairline to scale, so its cross direction is stretched and the caption says so.
+    ext
+}
+
+/// One unit is the same length across and up: fit the plot area to the data's aspect, then widen the
+/// shorter range to fill it. A corridor more than [`CORRIDOR_MAX_ASPECT`] times longer than wide (a 100 m
+/// lane) would be a hairline to scale, so its cross direction is stretched and the title says so. An empty
+/// band on top holds the legend, so it never hides a path.
+fn corridor_layout(input: &ReportInput) -> CorridorLayout {
+    let (x0, x1, y0, y1) = corridor_extent(input).padded(2.5 * HULL_HALF_WIDTH_UNITS);
     let plot_w = f64::from(FIGURE_WIDTH_PX - 2 * MARGIN_PX - Y_LABEL_PX);
     let (dx, dy) = (x1 - x0, y1 - y0);
     let to_scale = dx / dy <= CORRIDOR_MAX_ASPECT && dy / dx <= CORRIDOR_MAX_ASPECT;
@@ -181,11 +201,13 @@ pub fn corridor_svg(input: &ReportInput) -> io::Result<String> {
         let per_unit = px_per_x.min(px_per_y);
         (px_per_x, px_per_y) = (per_unit, per_unit);
     }
-    (x0, x1) = (cx - 0.5 * plot_w / px_per_x, cx + 0.5 * plot_w / px_per_x);
-    (y0, y1) = (cy - 0.5 * plot_h / px_per_y, cy + 0.5 * plot_h / px_per_y);
-    // An empty band on top for the legend, so it never hides a path.
-    y1 += f64::from(LEGEND_BAND_PX) / px_per_y;
-    let height = plot_h.round() as u32 + LEGEND_BAND_PX + 2 * MARGIN_PX + CAPTION_PX + X_LABEL_PX;
+    let x = (cx - 0.5 * plot_w / px_per_x, cx + 0.5 * plot_w / px_per_x);
+    let y = (
+        cy - 0.5 * plot_h / px_per_y,
+        cy + 0.5 * plot_h / px_per_y + f64::from(LEGEND_BAND_PX) / px_per_y,
+    );
+    let height_px =
+        plot_h.round() as u32 + LEGEND_BAND_PX + 2 * MARGIN_PX + CAPTION_PX + X_LABEL_PX;
     let title = if to_scale {
         format!(
             "{}: the corridor and the paths (to scale)",
@@ -198,168 +220,212 @@ pub fn corridor_svg(input: &ReportInput) -> io::Result<String> {
             px_per_y / px_per_x
         )
     };
+    CorridorLayout {
+        x,
+        y,
+        px_per_x,
+        px_per_y,
+        height_px,
+        title,
+    }
+}
 
-    svg_figure(height, |root| {
+/// A legend entry drawn as a short line in `style`.
+fn line_legend(style: ShapeStyle) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style)
+}
+
+/// Solid walls (black), rule lines (orange, dashed) and the finish line (green), each kind once in the
+/// legend.
+fn draw_boundaries(chart: &mut Chart, input: &ReportInput) -> Draw {
+    let scene = input.scene;
+    let (mut rule_labelled, mut solid_labelled) = (false, false);
+    for wall in &scene.walls {
+        let mut pts: Vec<(f64, f64)> = wall.points.iter().map(|p| (p.x, p.y)).collect();
+        if wall.closed {
+            if let Some(&first) = pts.first() {
+                pts.push(first);
+            }
+        }
+        match wall.kind {
+            BoundaryKind::Rule => {
+                let style = RULE_COLOUR.stroke_width(2);
+                let s = chart.draw_series(DashedLineSeries::new(pts, 10, 6, style))?;
+                if !rule_labelled {
+                    rule_labelled = true;
+                    s.label("rule line (must not be crossed)")
+                        .legend(line_legend(style));
+                }
+            }
+            BoundaryKind::Solid => {
+                let style = SOLID_COLOUR.stroke_width(3);
+                let s = chart.draw_series(LineSeries::new(pts, style))?;
+                if !solid_labelled {
+                    solid_labelled = true;
+                    s.label("solid wall").legend(line_legend(style));
+                }
+            }
+        }
+    }
+    let finish = FINISH_COLOUR.stroke_width(4);
+    chart
+        .draw_series(LineSeries::new(
+            [
+                (scene.finish.a.x, scene.finish.a.y),
+                (scene.finish.b.x, scene.finish.b.y),
+            ],
+            finish,
+        ))?
+        .label("finish line")
+        .legend(line_legend(finish));
+    Ok(())
+}
+
+/// The lower bound's shortest path of the hull centre (grey, dashed).
+fn draw_bound_path(chart: &mut Chart, input: &ReportInput) -> Draw {
+    let style = BOUND_COLOUR.stroke_width(1);
+    let pts: Vec<(f64, f64)> = input.bound.path.iter().map(|p| (p.x, p.y)).collect();
+    chart
+        .draw_series(DashedLineSeries::new(pts, 4, 4, style))?
+        .label("shortest path (lower bound)")
+        .legend(line_legend(style));
+    Ok(())
+}
+
+/// The 32 x 32 hull centred at `p`.
+fn hull_box(p: Vec2, style: ShapeStyle) -> Rectangle<(f64, f64)> {
+    let h = HULL_HALF_WIDTH_UNITS;
+    Rectangle::new([(p.x - h, p.y - h), (p.x + h, p.y + h)], style)
+}
+
+/// [`HULL_BOXES_PER_RUN`] evenly spaced positions of `recs`, the first and the last included.
+fn hull_box_positions(recs: &[&FrameRecord]) -> Vec<Vec2> {
+    let n = recs.len();
+    let count = HULL_BOXES_PER_RUN.min(n);
+    (0..count)
+        .map(|k| {
+            recs[if count > 1 {
+                k * (n - 1) / (count - 1)
+            } else {
+                0
+            }]
+            .pos
+        })
+        .collect()
+}
+
+/// Run `i`'s path in its colour, with the hull at a few frames (labelled once, for the first run).
+fn draw_run_path(chart: &mut Chart, i: usize, run: &ReportRun) -> Draw {
+    let colour = run_colour(i);
+    let recs: Vec<&FrameRecord> = records(run.trace).filter(|r| r.pos.is_finite()).collect();
+    let pts: Vec<(f64, f64)> = recs.iter().map(|r| (r.pos.x, r.pos.y)).collect();
+    let line = colour.stroke_width(2);
+    chart
+        .draw_series(LineSeries::new(thin(&pts, MAX_POINTS_PER_SERIES), line))?
+        .label(if run.label == run.trace.controller {
+            run.label.to_string()
+        } else {
+            format!("{} ({})", run.label, run.trace.controller)
+        })
+        .legend(line_legend(line));
+    let box_style = colour.mix(0.7).stroke_width(1);
+    let s = chart.draw_series(
+        hull_box_positions(&recs)
+            .into_iter()
+            .map(|p| hull_box(p, box_style)),
+    )?;
+    if i == 0 {
+        s.label("32 x 32 hull at a few frames")
+            .legend(move |(x, y)| Rectangle::new([(x + 4, y - 6), (x + 16, y + 6)], box_style));
+    }
+    Ok(())
+}
+
+/// A red hull and cross at the run's first rule violation and first wall contact, each with its label
+/// beside the hull on the side with room.
+fn draw_run_marks(chart: &mut Chart, run: &ReportRun, layout: &CorridorLayout) -> Draw {
+    let h = HULL_HALF_WIDTH_UNITS;
+    let marks = [
+        (run.trace.first_rule_violation(), "rule broken"),
+        (run.trace.first_contact(), "first wall contact"),
+    ];
+    for (frame, what) in marks {
+        let Some(frame) = frame else { continue };
+        let Some(rec) = run.trace.frames.iter().find(|f| f.frame == frame) else {
+            continue;
+        };
+        if !rec.pos.is_finite() {
+            continue;
+        }
+        let mark = MARK_COLOUR.stroke_width(2);
+        chart.draw_series([hull_box(rec.pos, mark)])?;
+        chart.draw_series([Cross::new((rec.pos.x, rec.pos.y), 8, mark)])?;
+        let text = format!("{}: {what}, frame {frame}", run.label);
+        // About 7 px a character.
+        let text_w = 7.0 * text.chars().count() as f64 / layout.px_per_x;
+        let gap = 1.5 * h.max(6.0 / layout.px_per_x);
+        let tx = if rec.pos.x + gap + text_w > layout.x.1 {
+            rec.pos.x - gap - text_w
+        } else {
+            rec.pos.x + gap
+        };
+        chart.draw_series([Text::new(
+            text,
+            (tx, rec.pos.y + 1.5 * h.max(6.0 / layout.px_per_y)),
+            ("sans-serif", 14).into_font().color(&MARK_COLOUR),
+        )])?;
+    }
+    Ok(())
+}
+
+/// The legend box in `position`, the same style in every figure.
+fn draw_legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, position: SeriesLabelPosition) -> Draw {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 13))
+        .draw()?;
+    Ok(())
+}
+
+/// Axes with a light grid and the given descriptions.
+fn draw_axes(chart: &mut Chart, x_desc: &str, y_desc: &str) -> Draw {
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    Ok(())
+}
+
+/// Figure 1: the corridor, to scale: solid walls (black), rule lines (orange, dashed), the finish line
+/// (green), the lower bound's shortest path (grey, dashed), each run's path with the 32 x 32 hull at a few
+/// frames, and a red cross at each run's first rule violation and first wall contact.
+pub fn corridor_svg(input: &ReportInput) -> io::Result<String> {
+    let layout = corridor_layout(input);
+    svg_figure(layout.height_px, |root| {
         let mut chart = ChartBuilder::on(root)
-            .caption(title, ("sans-serif", 20))
+            .caption(&layout.title, ("sans-serif", 20))
             .margin(MARGIN_PX)
             .x_label_area_size(X_LABEL_PX)
             .y_label_area_size(Y_LABEL_PX)
-            .build_cartesian_2d(x0..x1, y0..y1)?;
-        chart
-            .configure_mesh()
-            .x_desc("x (units)")
-            .y_desc("y (units)")
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
-
-        let (mut rule_labelled, mut solid_labelled) = (false, false);
-        for wall in &scene.walls {
-            let mut pts: Vec<(f64, f64)> = wall.points.iter().map(|p| (p.x, p.y)).collect();
-            if wall.closed {
-                if let Some(&first) = pts.first() {
-                    pts.push(first);
-                }
-            }
-            match wall.kind {
-                BoundaryKind::Rule => {
-                    let style = RULE_COLOUR.stroke_width(2);
-                    let s = chart.draw_series(DashedLineSeries::new(pts, 10, 6, style))?;
-                    if !rule_labelled {
-                        rule_labelled = true;
-                        s.label("rule line (must not be crossed)")
-                            .legend(move |(x, y)| {
-                                PathElement::new(vec![(x, y), (x + 20, y)], style)
-                            });
-                    }
-                }
-                BoundaryKind::Solid => {
-                    let style = SOLID_COLOUR.stroke_width(3);
-                    let s = chart.draw_series(LineSeries::new(pts, style))?;
-                    if !solid_labelled {
-                        solid_labelled = true;
-                        s.label("solid wall").legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], style)
-                        });
-                    }
-                }
-            }
-        }
-        let finish = FINISH_COLOUR.stroke_width(4);
-        chart
-            .draw_series(LineSeries::new(
-                [
-                    (scene.finish.a.x, scene.finish.a.y),
-                    (scene.finish.b.x, scene.finish.b.y),
-                ],
-                finish,
-            ))?
-            .label("finish line")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], finish));
-        let bound_style = BOUND_COLOUR.stroke_width(1);
-        chart
-            .draw_series(DashedLineSeries::new(
-                input
-                    .bound
-                    .path
-                    .iter()
-                    .map(|p| (p.x, p.y))
-                    .collect::<Vec<_>>(),
-                4,
-                4,
-                bound_style,
-            ))?
-            .label("shortest path (lower bound)")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], bound_style));
-
-        let h = HULL_HALF_WIDTH_UNITS;
-        let hull = |p: Vec2, style: ShapeStyle| {
-            Rectangle::new([(p.x - h, p.y - h), (p.x + h, p.y + h)], style)
-        };
+            .build_cartesian_2d(layout.x.0..layout.x.1, layout.y.0..layout.y.1)?;
+        draw_axes(&mut chart, "x (units)", "y (units)")?;
+        draw_boundaries(&mut chart, input)?;
+        draw_bound_path(&mut chart, input)?;
         for (i, run) in input.runs.iter().enumerate() {
-            let colour = run_colour(i);
-            let recs: Vec<&FrameRecord> =
-                records(run.trace).filter(|r| r.pos.is_finite()).collect();
-            let pts: Vec<(f64, f64)> = recs.iter().map(|r| (r.pos.x, r.pos.y)).collect();
-            let line = colour.stroke_width(2);
-            chart
-                .draw_series(LineSeries::new(thin(&pts, MAX_POINTS_PER_SERIES), line))?
-                .label(if run.label == run.trace.controller {
-                    run.label.to_string()
-                } else {
-                    format!("{} ({})", run.label, run.trace.controller)
-                })
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
-            // The hull at evenly spaced frames, start and end included.
-            let n = recs.len();
-            let boxes: Vec<Vec2> = if n == 0 {
-                Vec::new()
-            } else {
-                let count = HULL_BOXES_PER_RUN.min(n);
-                (0..count)
-                    .map(|k| {
-                        recs[if count > 1 {
-                            k * (n - 1) / (count - 1)
-                        } else {
-                            0
-                        }]
-                        .pos
-                    })
-                    .collect()
-            };
-            let box_style = colour.mix(0.7).stroke_width(1);
-            let s = chart.draw_series(boxes.into_iter().map(|p| hull(p, box_style)))?;
-            if i == 0 {
-                s.label("32 x 32 hull at a few frames")
-                    .legend(move |(x, y)| {
-                        Rectangle::new([(x + 4, y - 6), (x + 16, y + 6)], box_style)
-                    });
-            }
-            // Marks: the first rule violation and the first wall contact.
-            let marks = [
-                (run.trace.first_rule_violation(), "rule broken"),
-                (run.trace.first_contact(), "first wall contact"),
-            ];
-            for (frame, what) in marks {
-                let Some(frame) = frame else { continue };
-                let Some(rec) = run.trace.frames.iter().find(|f| f.frame == frame) else {
-                    continue;
-                };
-                if !rec.pos.is_finite() {
-                    continue;
-                }
-                let mark = MARK_COLOUR.stroke_width(2);
-                chart.draw_series([hull(rec.pos, mark)])?;
-                chart.draw_series([Cross::new((rec.pos.x, rec.pos.y), 8, mark)])?;
-                let text = format!("{}: {what}, frame {frame}", run.label);
-                // Beside the hull, on the side with room (about 7 px a character).
-                let text_w = 7.0 * text.chars().count() as f64 / px_per_x;
-                let gap = 1.5 * h.max(6.0 / px_per_x);
-                let tx = if rec.pos.x + gap + text_w > x1 {
-                    rec.pos.x - gap - text_w
-                } else {
-                    rec.pos.x + gap
-                };
-                chart.draw_series([Text::new(
-                    text,
-                    (tx, rec.pos.y + 1.5 * h.max(6.0 / px_per_y)),
-                    ("sans-serif", 14).into_font().color(&MARK_COLOUR),
-                )])?;
-            }
+            draw_run_path(&mut chart, i, run)?;
+            draw_run_marks(&mut chart, run, &layout)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .draw()?;
-        Ok(())
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
     })
 }
 
 /// The lower bound's speed profile: the speed after each frame from the start speed, iterating
-/// [`SpeedBound::next`] (physics.md section 6), for frames `1..=frames`, as `(time s, speed ups)`.
+/// [`SpeedBound::next`] (docs/physics.md section 6), for frames `1..=frames`, as `(time s, speed ups)`.
 pub fn bound_speed_profile(input: &ReportInput, frames: u64) -> Vec<(f64, f64)> {
     let scene = input.scene;
     let bound = SpeedBound::new(&scene.vars, scene.effects);
@@ -467,94 +533,194 @@ fn wrap_degrees(angle: f64) -> f64 {
     }
 }
 
-/// Yaw in degrees made continuous (no jumps of 360), for plotting.
-pub(crate) fn unwrapped_yaw_degrees(frames: &[FrameRecord]) -> Vec<(f64, f64)> {
-    let mut out = Vec::with_capacity(frames.len());
-    let mut prev: Option<(f64, f64)> = None; // (raw, unwrapped)
-    for f in frames.iter().filter(|f| f.yaw_rad.is_finite()) {
-        let raw = f.yaw_rad.to_degrees();
-        let y = match prev {
-            Some((p_raw, p_y)) => p_y + wrap_degrees(raw - p_raw),
-            None => raw,
+/// Frames the turn rate is averaged over. Even, so the heading of a run that changes sides every frame
+/// (a zigzag with a period of two frames) averages out; at 100 fps 0.08 s, at 66.67 ticks/s 0.12 s.
+pub const TURN_RATE_WINDOW_FRAMES: usize = 8;
+
+/// Below this speed, ups, the heading is not drawn: the direction of a velocity near zero is noise.
+pub const HEADING_MIN_SPEED_UPS: f64 = 1.0;
+
+/// The heading of the velocity (not the view) at the start and after each frame, degrees anticlockwise
+/// from +x, as `(time s, degrees)`. The first is wrapped into `(-180, 180]`; each next one adds the
+/// frame's turn of the velocity wrapped into `(-180, 180]`, so a run that goes round a hairpin reads 0 to
+/// 180 and a run that alternates sides stays level (a velocity turns far less than half a turn in a frame;
+/// the view does not, which is why the yaw is not plotted). Records slower than
+/// [`HEADING_MIN_SPEED_UPS`] are left out.
+pub fn heading_degrees(trace: &Trace) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    let mut prev_raw: Option<f64> = None;
+    for r in records(trace) {
+        if !(r.vel.is_finite() && r.speed.is_finite() && r.speed >= HEADING_MIN_SPEED_UPS) {
+            continue;
+        }
+        let raw = r.vel.angle().to_degrees();
+        let heading = match (prev_raw, out.last()) {
+            (Some(p), Some(&(_, h))) => h + wrap_degrees(raw - p),
+            _ => wrap_degrees(raw),
         };
-        prev = Some((raw, y));
-        out.push((f.time, y));
+        prev_raw = Some(raw);
+        out.push((r.time, heading));
     }
     out
 }
 
-/// Figure 3: the strafe angle theta (top) and the view yaw (bottom, made continuous), degrees against
-/// time, for each frame of each run.
-pub fn angles_svg(input: &ReportInput) -> io::Result<String> {
-    let t_end = end_time(input) * 1.02;
-    let thetas: Vec<Vec<(f64, f64)>> = input
-        .runs
-        .iter()
-        .map(|r| {
-            r.trace
-                .frames
-                .iter()
-                .filter(|f| f.theta_rad.is_finite())
-                .map(|f| (f.time, f.theta_rad.to_degrees()))
-                .collect()
+/// The turn rate of the velocity's heading, degrees per second (positive: anticlockwise, to the left),
+/// averaged over [`TURN_RATE_WINDOW_FRAMES`] frames: for each window of that many frames of
+/// [`heading_degrees`], the heading's change over the window's time, at the window's middle time.
+/// Empty when the run has fewer headings than a window.
+pub fn turn_rate_deg_per_s(trace: &Trace) -> Vec<(f64, f64)> {
+    heading_degrees(trace)
+        .windows(TURN_RATE_WINDOW_FRAMES + 1)
+        .filter_map(|w| {
+            let (first, last) = (w[0], w[TURN_RATE_WINDOW_FRAMES]);
+            let dt = last.0 - first.0;
+            (dt > 0.0).then(|| (0.5 * (first.0 + last.0), (last.1 - first.1) / dt))
         })
-        .collect();
-    let yaws: Vec<Vec<(f64, f64)>> = input
+        .collect()
+}
+
+/// The clearance of the hull to the nearest wall or rule line at the start and after each frame, as
+/// `(time s, units)`; negative when overlapping. Left empty when the scene has no walls (infinite
+/// clearance). Its minimum is [`Trace::min_clearance`].
+pub fn clearance_series(trace: &Trace) -> Vec<(f64, f64)> {
+    records(trace)
+        .filter(|r| r.clearance.is_finite())
+        .map(|r| (r.time, r.clearance))
+        .collect()
+}
+
+/// One line per run of `data` on `chart`, in the runs' colours, labelled.
+fn draw_run_lines(chart: &mut Chart, input: &ReportInput, data: &[Vec<(f64, f64)>]) -> Draw {
+    for (i, (run, pts)) in input.runs.iter().zip(data).enumerate() {
+        let line = run_colour(i).stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(thin(pts, MAX_POINTS_PER_SERIES), line))?
+            .label(run.label)
+            .legend(line_legend(line));
+    }
+    Ok(())
+}
+
+/// A thin grey horizontal line at `y` across `x`.
+fn draw_level(chart: &mut Chart, x: (f64, f64), y: f64) -> Draw {
+    chart.draw_series(LineSeries::new(
+        [(x.0, y), (x.1, y)],
+        BOUND_COLOUR.stroke_width(1),
+    ))?;
+    Ok(())
+}
+
+/// Figure 3: where the runs are heading and how fast they turn: the velocity's heading (top, degrees,
+/// [`heading_degrees`]) and its turn rate averaged over [`TURN_RATE_WINDOW_FRAMES`] frames (bottom,
+/// degrees per second, [`turn_rate_deg_per_s`]), against time.
+pub fn heading_svg(input: &ReportInput) -> io::Result<String> {
+    let t_end = end_time(input) * 1.02;
+    let headings: Vec<Vec<(f64, f64)>> = input
         .runs
         .iter()
-        .map(|r| unwrapped_yaw_degrees(&r.trace.frames))
+        .map(|r| heading_degrees(r.trace))
         .collect();
-    let theta_range = value_range(thetas.iter().flatten().map(|p| p.1), 0.08);
-    let yaw_range = value_range(yaws.iter().flatten().map(|p| p.1), 0.08);
+    let rates: Vec<Vec<(f64, f64)>> = input
+        .runs
+        .iter()
+        .map(|r| turn_rate_deg_per_s(r.trace))
+        .collect();
+    let heading_range = value_range(headings.iter().flatten().map(|p| p.1), 0.08);
+    // Zero is always on the turn-rate axis: a straight run reads as a line on it.
+    let rate_range = value_range(rates.iter().flatten().map(|p| p.1).chain([0.0]), 0.08);
+    let rate_title =
+        format!("Turn rate of the velocity, averaged over {TURN_RATE_WINDOW_FRAMES} frames");
     svg_figure(640, |root| {
         let panels = root.split_evenly((2, 1));
         let specs = [
             (
-                "Strafe angle theta against time",
-                "theta (degrees)",
-                &thetas,
-                theta_range,
+                "Heading of the velocity against time",
+                "heading (degrees)",
+                &headings,
+                heading_range,
+                None,
             ),
             (
-                "View yaw against time",
-                "yaw (degrees, continuous)",
-                &yaws,
-                yaw_range,
+                rate_title.as_str(),
+                "turn rate (degrees/s, + left)",
+                &rates,
+                rate_range,
+                Some(0.0),
             ),
         ];
-        for (panel, (title, y_desc, data, (ylo, yhi))) in panels.iter().zip(specs) {
+        for (panel, (title, y_desc, data, (ylo, yhi), level)) in panels.iter().zip(specs) {
             let mut chart = ChartBuilder::on(panel)
                 .caption(title, ("sans-serif", 18))
                 .margin(MARGIN_PX)
                 .x_label_area_size(X_LABEL_PX)
                 .y_label_area_size(Y_LABEL_PX)
                 .build_cartesian_2d(0.0..t_end, ylo..yhi)?;
-            chart
-                .configure_mesh()
-                .x_desc("time (s)")
-                .y_desc(y_desc)
-                .light_line_style(RGBColor(235, 235, 235))
-                .draw()?;
-            for (i, (run, pts)) in input.runs.iter().zip(data.iter()).enumerate() {
-                let line = run_colour(i).stroke_width(1);
-                chart
-                    .draw_series(LineSeries::new(thin(pts, MAX_POINTS_PER_SERIES), line))?
-                    .label(run.label)
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
+            draw_axes(&mut chart, "time (s)", y_desc)?;
+            if let Some(y) = level {
+                draw_level(&mut chart, (0.0, t_end), y)?;
             }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 13))
-                .draw()?;
+            draw_run_lines(&mut chart, input, data)?;
+            draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }
         Ok(())
     })
 }
 
-/// The radius of the circle through each frame's position and its neighbours' (physics.md section 9),
+/// Figure 4: the clearance of the hull to the nearest wall or rule line along each run
+/// ([`clearance_series`]), units against time, with each run's minimum marked and labelled and a grey
+/// line at zero (touching).
+pub fn clearance_svg(input: &ReportInput) -> io::Result<String> {
+    let t_end = end_time(input) * 1.02;
+    let series: Vec<Vec<(f64, f64)>> = input
+        .runs
+        .iter()
+        .map(|r| clearance_series(r.trace))
+        .collect();
+    let (ylo, yhi) = value_range(series.iter().flatten().map(|p| p.1).chain([0.0]), 0.08);
+    svg_figure(420, |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(
+                "Clearance to the nearest wall or rule line against time",
+                ("sans-serif", 20),
+            )
+            .margin(MARGIN_PX)
+            .x_label_area_size(X_LABEL_PX)
+            .y_label_area_size(Y_LABEL_PX)
+            .build_cartesian_2d(0.0..t_end, ylo..yhi)?;
+        draw_axes(&mut chart, "time (s)", "clearance (units)")?;
+        draw_level(&mut chart, (0.0, t_end), 0.0)?;
+        draw_run_lines(&mut chart, input, &series)?;
+        for (i, (run, pts)) in input.runs.iter().zip(&series).enumerate() {
+            let Some(&(t, c)) = pts.iter().min_by(|a, b| a.1.total_cmp(&b.1)) else {
+                continue;
+            };
+            let colour = run_colour(i);
+            // The label above the point, on the side with room; later runs' labels higher, so two minima
+            // at one time stay readable.
+            let right_half = t > 0.5 * t_end;
+            let (dx, h_pos) = if right_half {
+                (-8, HPos::Right)
+            } else {
+                (8, HPos::Left)
+            };
+            let dy = -8 - 16 * i32::try_from(i).unwrap_or(0);
+            let font = ("sans-serif", 13)
+                .into_font()
+                .color(&colour)
+                .pos(Pos::new(h_pos, VPos::Bottom));
+            chart.draw_series([EmptyElement::at((t, c))
+                + Circle::new((0, 0), 4, colour.filled())
+                + Text::new(
+                    format!("{}: min {c:.4} units at {t:.3} s", run.label),
+                    (dx, dy),
+                    font,
+                )])?;
+        }
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
+    })
+}
+
+/// The radius of the circle through each frame's position and its neighbours' (docs/physics.md section 9),
 /// against the speed at the middle position, as `(speed ups, radius units)`; straight stretches (infinite
 /// radius) are left out.
 pub fn turn_radii(trace: &Trace) -> Vec<(f64, f64)> {
@@ -568,12 +734,17 @@ pub fn turn_radii(trace: &Trace) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// Figure 4: the turn radius of every frame against speed (log scale), with the section-9 relations of
-/// maximum-acceleration airstrafing drawn over it: the source text's relation and the first-order radius
-/// `tau |v'|^2 / (mu sin theta)` (which the circle through three simulated positions follows).
-pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
-    let vars = &input.scene.vars;
-    let points: Vec<Vec<(f64, f64)>> = input.runs.iter().map(|r| turn_radii(r.trace)).collect();
+/// The radius figure's axes: the speeds shown, the radii shown (log scale), and the section-9 relations of
+/// maximum-acceleration airstrafing sampled over those speeds as `(speed, source text's, first order)`.
+struct RadiusAxes {
+    speed: (f64, f64),
+    radius: (f64, f64),
+    relations: Vec<(f64, f64, f64)>,
+}
+
+/// Axes that hold the runs' radii `points` and the relations; without points, speeds from the max speed to
+/// three times it.
+fn radius_axes(vars: &MovementVars, points: &[Vec<(f64, f64)>]) -> RadiusAxes {
     let (mut v_lo, mut v_hi) = value_range(points.iter().flatten().map(|p| p.0), 0.0);
     if points.iter().all(Vec::is_empty) {
         (v_lo, v_hi) = (vars.maxspeed, 3.0 * vars.maxspeed);
@@ -587,14 +758,11 @@ pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
             (v, r.source_text, r.first_order)
         })
         .collect();
-    let relation_max = relations
-        .iter()
-        .flat_map(|r| [r.1, r.2])
+    let relation_radii = || relations.iter().flat_map(|r| [r.1, r.2]);
+    let relation_max = relation_radii()
         .filter(|r| r.is_finite())
         .fold(0.0, f64::max);
-    let relation_min = relations
-        .iter()
-        .flat_map(|r| [r.1, r.2])
+    let relation_min = relation_radii()
         .filter(|r| r.is_finite() && *r > 0.0)
         .fold(f64::INFINITY, f64::min);
     let data_min = points
@@ -611,11 +779,28 @@ pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
     };
     let r_lo = (data_min.min(relation_min) * 0.8).clamp(1e-3, 1e9);
     let r_hi = (data_max.max(relation_max).min(cap) * 1.25).max(r_lo * 10.0);
+    RadiusAxes {
+        speed: (v_lo, v_hi),
+        radius: (r_lo, r_hi),
+        relations,
+    }
+}
+
+/// Figure 5: the turn radius of every frame against speed (log scale), with the section-9 relations of
+/// maximum-acceleration airstrafing drawn over it: the source text's relation and the first-order radius
+/// `tau |v'|^2 / (mu sin theta)` (which the circle through three simulated positions follows).
+pub fn radius_svg(input: &ReportInput) -> io::Result<String> {
+    let points: Vec<Vec<(f64, f64)>> = input.runs.iter().map(|r| turn_radii(r.trace)).collect();
+    let RadiusAxes {
+        speed: (v_lo, v_hi),
+        radius: (r_lo, r_hi),
+        relations,
+    } = radius_axes(&input.scene.vars, &points);
     let x_pad = 0.03 * (v_hi - v_lo);
     svg_figure(520, |root| {
         let mut chart = ChartBuilder::on(root)
             .caption(
-                "Turn radius per frame against speed (physics.md section 9)",
+                "Turn radius per frame against speed (docs/physics.md section 9)",
                 ("sans-serif", 20),
             )
             .margin(MARGIN_PX)
@@ -693,27 +878,87 @@ mod tests {
         assert_eq!(thin(&v[..5], 2000), vec![0, 1, 2, 3, 4]);
     }
 
-    #[test]
-    fn yaw_is_unwrapped() {
-        let mk = |frame: u64, deg: f64| FrameRecord {
+    fn record(frame: u64, heading_deg: f64, speed: f64) -> FrameRecord {
+        let vel = Vec2::new(
+            heading_deg.to_radians().cos(),
+            heading_deg.to_radians().sin(),
+        ) * speed;
+        FrameRecord {
             frame,
-            time: frame as f64,
+            time: frame as f64 * 0.01,
             pos: Vec2::ZERO,
-            vel: Vec2::ZERO,
-            speed: 0.0,
-            yaw_rad: deg.to_radians(),
+            vel,
+            speed,
+            // The view swings half a turn every frame, as it does when sides alternate.
+            yaw_rad: (180.0 * frame as f64).to_radians(),
             theta_rad: 0.0,
             on_ground: false,
             ducked: false,
-            clearance: 1.0,
+            clearance: 10.0 - frame as f64,
             contacts: 0,
             broke_rule: false,
-        };
-        let frames = [mk(1, 170.0), mk(2, -170.0), mk(3, -150.0)];
-        let y = unwrapped_yaw_degrees(&frames);
+        }
+    }
+
+    fn trace_of(headings_deg: &[f64], speed: f64) -> Trace {
+        Trace {
+            controller: "test".to_string(),
+            start: record(0, headings_deg[0], speed),
+            frames: headings_deg[1..]
+                .iter()
+                .enumerate()
+                .map(|(k, &h)| record(k as u64 + 1, h, speed))
+                .collect(),
+            controls: Vec::new(),
+            crossing: None,
+            numerical_failure: false,
+        }
+    }
+
+    #[test]
+    fn heading_is_continuous_through_the_back_direction() {
+        let t = trace_of(&[170.0, -170.0, -150.0], 300.0);
+        let h: Vec<f64> = heading_degrees(&t).iter().map(|p| p.1).collect();
+        assert_eq!(h.len(), 3);
         assert!(
-            (y[1].1 - 190.0).abs() < 1e-9 && (y[2].1 - 210.0).abs() < 1e-9,
-            "{y:?}"
+            (h[0] - 170.0).abs() < 1e-9
+                && (h[1] - 190.0).abs() < 1e-9
+                && (h[2] - 210.0).abs() < 1e-9,
+            "{h:?}"
         );
+    }
+
+    #[test]
+    fn turn_rate_of_a_steady_turn_and_of_a_zigzag() {
+        // 0.5 degrees a frame at 100 fps: 50 degrees per second, whatever the window.
+        let steady: Vec<f64> = (0..40).map(|k| 0.5 * k as f64).collect();
+        let rates = turn_rate_deg_per_s(&trace_of(&steady, 300.0));
+        assert_eq!(rates.len(), 40 - TURN_RATE_WINDOW_FRAMES);
+        assert!(rates.iter().all(|r| (r.1 - 50.0).abs() < 1e-9), "{rates:?}");
+        // Sides alternating every frame: the heading zigzags by 2 degrees and the average turn is zero.
+        let zigzag: Vec<f64> = (0..40)
+            .map(|k| if k % 2 == 0 { 0.0 } else { 2.0 })
+            .collect();
+        let rates = turn_rate_deg_per_s(&trace_of(&zigzag, 300.0));
+        assert!(rates.iter().all(|r| r.1.abs() < 1e-9), "{rates:?}");
+    }
+
+    #[test]
+    fn slow_records_have_no_heading() {
+        let mut t = trace_of(&[0.0, 10.0, 20.0], 300.0);
+        t.start.speed = 0.5 * HEADING_MIN_SPEED_UPS;
+        t.start.vel = Vec2::new(t.start.speed, 0.0);
+        let h = heading_degrees(&t);
+        assert_eq!(h.len(), 2);
+        assert!((h[0].1 - 10.0).abs() < 1e-9, "{h:?}");
+    }
+
+    #[test]
+    fn clearance_series_has_the_start_and_every_frame() {
+        let t = trace_of(&[0.0; 5], 300.0);
+        let c = clearance_series(&t);
+        assert_eq!(c.len(), 5);
+        let min = c.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+        assert_eq!(min, t.min_clearance());
     }
 }

@@ -9,7 +9,7 @@
 //! `+moveright`, `< 0` is `+moveleft` (our controllers hold full keys, `cl_forwardspeed` /
 //! `cl_sidespeed`, so nothing is lost). The script cannot set the start state: the player must be placed at
 //! the scene's start position and velocity before it runs (the header comments say where). The game
-//! quantises each yaw by anglemod (physics.md section 1); a plan meant for the game should be checked in
+//! quantises each yaw by anglemod (docs/physics.md section 1); a plan meant for the game should be checked in
 //! engine-exact mode.
 //!
 //! [`Control::yaw_rad`]: crate::physics::Control::yaw_rad

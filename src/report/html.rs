@@ -1,4 +1,4 @@
-//! The self-contained HTML report: one file, no scripts, no external resources. Four SVG figures drawn
+//! The self-contained HTML report: one file, no scripts, no external resources. Five SVG figures drawn
 //! by plotters ([`super::figures`]), a table of the runs, the section-9 radius relations at a few speeds,
 //! and a table of the summary (the `--json` object).
 //!
@@ -68,18 +68,19 @@ impl<'a> ReportInput<'a> {
     }
 }
 
-/// Element ids of the four figures, in order: corridor, speed, angles, radius.
-pub const FIGURE_IDS: [&str; 4] = [
+/// Element ids of the five figures, in order: corridor, speed, heading and turn rate, clearance, radius.
+pub const FIGURE_IDS: [&str; 5] = [
     "figure-corridor",
     "figure-speed",
-    "figure-angles",
+    "figure-heading",
+    "figure-clearance",
     "figure-radius",
 ];
 
 /// Id of the summary table.
 pub const SUMMARY_TABLE_ID: &str = "summary";
 
-/// Writes the report as one HTML document to `w`: the runs table, figures 1-4 (each an inline `<svg>` in
+/// Writes the report as one HTML document to `w`: the runs table, figures 1-5 (each an inline `<svg>` in
 /// a `<figure>` with the ids of [`FIGURE_IDS`]), the section-9 table and the summary table
 /// (`<table id="summary">`). Deterministic: the same input gives the same bytes.
 ///
@@ -110,43 +111,7 @@ pub fn write_html(input: &ReportInput, w: &mut impl Write) -> io::Result<()> {
 
     write_runs_table(input, w)?;
 
-    let figures: [(&str, io::Result<String>, String); 4] = [
-        (
-            FIGURE_IDS[0],
-            figures::corridor_svg(input),
-            "Figure 1. The corridor (to scale unless the title says the y axis is stretched): solid walls in black, rule lines dashed orange, the finish \
-             line green, the lower bound's shortest path dashed grey; each run's path with the 32 x 32 hull \
-             at a few frames, and its first rule violation or wall contact marked in red."
-                .to_string(),
-        ),
-        (
-            FIGURE_IDS[1],
-            figures::speed_svg(input),
-            format!(
-                "Figure 2. Speed against time. The grey dashed curve is the lower bound's speed profile: \
-                 the largest speed any control sequence can have after each frame (physics.md section 6); \
-                 the vertical lines mark the crossings (lower bound at {:.4} s).",
-                input.bound.crossing.time
-            ),
-        ),
-        (
-            FIGURE_IDS[2],
-            figures::angles_svg(input),
-            "Figure 3. The strafe angle theta between the velocity and the wish direction (top) and the \
-             view yaw (bottom, with whole turns added so the curve is continuous), degrees."
-                .to_string(),
-        ),
-        (
-            FIGURE_IDS[3],
-            figures::radius_svg(input),
-            "Figure 4. The radius of the circle through each position and its neighbours, against speed. \
-             The curves are maximum-acceleration airstrafing at these settings: the source text's relation \
-             (dashed) gives about twice the radius the game draws; the first-order radius (solid) is the \
-             one corners are planned with (physics.md section 9)."
-                .to_string(),
-        ),
-    ];
-    for (id, svg, caption) in figures {
+    for (id, svg, caption) in captioned_figures(input) {
         let svg = svg?;
         writeln!(
             w,
@@ -171,6 +136,57 @@ pub fn write_html(input: &ReportInput, w: &mut impl Write) -> io::Result<()> {
         )?;
     }
     writeln!(w, "</table>\n</body>\n</html>")
+}
+
+/// The five figures in order, each with its element id (from [`FIGURE_IDS`]) and its caption.
+fn captioned_figures(input: &ReportInput) -> [(&'static str, io::Result<String>, String); 5] {
+    [
+        (
+            FIGURE_IDS[0],
+            figures::corridor_svg(input),
+            "Figure 1. The corridor (to scale unless the title says the y axis is stretched): solid walls in black, rule lines dashed orange, the finish \
+             line green, the lower bound's shortest path dashed grey; each run's path with the 32 x 32 hull \
+             at a few frames, and its first rule violation or wall contact marked in red."
+                .to_string(),
+        ),
+        (
+            FIGURE_IDS[1],
+            figures::speed_svg(input),
+            format!(
+                "Figure 2. Speed against time. The grey dashed curve is the lower bound's speed profile: \
+                 the largest speed any control sequence can have after each frame (docs/physics.md section 6); \
+                 the vertical lines mark the crossings (lower bound at {:.4} s).",
+                input.bound.crossing.time
+            ),
+        ),
+        (
+            FIGURE_IDS[2],
+            figures::heading_svg(input),
+            format!(
+                "Figure 3. Where each run is heading: the direction of the velocity (top, degrees \
+                 anticlockwise from +x, continuous through half turns) and how fast it turns (bottom, \
+                 degrees per second, positive to the left), averaged over {} frames so that a run which \
+                 changes sides every frame reads as its mean turn.",
+                figures::TURN_RATE_WINDOW_FRAMES
+            ),
+        ),
+        (
+            FIGURE_IDS[3],
+            figures::clearance_svg(input),
+            "Figure 4. Clearance of the 32 x 32 hull to the nearest wall or rule line along each run, \
+             units (negative: overlapping), with each run's smallest clearance marked."
+                .to_string(),
+        ),
+        (
+            FIGURE_IDS[4],
+            figures::radius_svg(input),
+            "Figure 5. The radius of the circle through each position and its neighbours, against speed. \
+             The curves are maximum-acceleration airstrafing at these settings: the source text's relation \
+             (dashed) gives about twice the radius the game draws; the first-order radius (solid) is the \
+             one corners are planned with (docs/physics.md section 9)."
+                .to_string(),
+        ),
+    ]
 }
 
 const STYLE: &str = "body{font-family:sans-serif;margin:2em;max-width:1000px;color:#222}\
@@ -238,7 +254,7 @@ fn write_radius_table(input: &ReportInput, w: &mut impl Write) -> io::Result<()>
     let vars = &input.scene.vars;
     writeln!(
         w,
-        "<h2>The radius-speed relation (physics.md section 9)</h2>\n<p>Maximum-acceleration airstrafing at \
+        "<h2>The radius-speed relation (docs/physics.md section 9)</h2>\n<p>Maximum-acceleration airstrafing at \
          {} fps: the source text's relation against the radius the game draws.</p>\n<table id=\"radii\">\n\
          <tr><th>speed (ups)</th><th>theta (deg)</th><th>source text's relation</th><th>first order</th>\
          <th>circle through 3 simulated positions</th><th>relation / measured</th></tr>",

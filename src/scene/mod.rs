@@ -5,7 +5,7 @@
 //! description = "..."                # optional
 //! max-frames = 2000                  # optional; default DEFAULT_MAX_TIME_S of frames
 //! [engine]
-//! preset = "goldsrc"                 # or "source-hl2" (physics.md section 2)
+//! preset = "goldsrc"                 # or "source-hl2" (docs/physics.md section 2)
 //! fps = 100                          # required; plus any movement variable: airaccelerate = 100, ...
 //! effects = ["air-accel", "max-velocity", "walls"]
 //! [start]                            # each key optional when a shorthand shape gives a default
@@ -78,9 +78,9 @@ pub struct Scene {
     pub origin: String,
     /// The preset the variables start from.
     pub preset: Preset,
-    /// Movement variables: the preset with the file's overrides, validated (physics.md section 2).
+    /// Movement variables: the preset with the file's overrides, validated (docs/physics.md section 2).
     pub vars: MovementVars,
-    /// The effects simulated (physics.md section 3), every requirement present.
+    /// The effects simulated (docs/physics.md section 3), every requirement present.
     pub effects: Effects,
     /// The player at frame 0.
     pub start: PlayerState,
@@ -114,7 +114,7 @@ impl Scene {
         Corridor::new(&self.walls)
     }
 
-    /// Frame time `tau`, seconds (physics.md section 1).
+    /// Frame time `tau`, seconds (docs/physics.md section 1).
     pub fn frame_time_s(&self) -> f64 {
         self.vars.frame_time_s()
     }

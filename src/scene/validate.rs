@@ -32,7 +32,7 @@ struct Shape {
 fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
     let shape = shorthand(&file, ix)?;
 
-    // Engine: preset + overrides, then effects (physics.md sections 2, 3).
+    // Engine: preset + overrides, then effects (docs/physics.md sections 2, 3).
     let engine = &file.engine;
     let fps = engine.overrides.fps.ok_or_else(|| {
         ix.error(

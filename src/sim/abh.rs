@@ -1,11 +1,11 @@
-//! A frame-level accelerated-backhop (ABH) controller (physics.md section 11, the article in
+//! A frame-level accelerated-backhop (ABH) controller (docs/physics.md section 11, the article in
 //! `seeds/001_d17d1c79a27eb9a1.txt`), run through the ordinary frame loop ([`Simulation::run`]): duck,
 //! gravity, jumps, the Source jump boost, friction and the lane rules of the scene all apply.
 //!
 //! The run, from the pistol at frame 0 (crouched, at rest):
 //! 1. **Stand up**: duck released; standing takes `TIME_TO_UNDUCK` (the scene's `unduck_time_s`, 0.2 s,
 //!    which at tau = 0.015 s is 14 frames). The article walks only once standing; [`AbhParams`] can hold
-//!    forward while standing up instead (the duck crop, physics.md section 2, then applies).
+//!    forward while standing up instead (the duck crop, docs/physics.md section 2, then applies).
 //! 2. **Walk** forward (forwardmove = the full key, which the game scales down to the max speed) until the
 //!    speed before a frame reaches [`AbhParams::walk_speed_ups`].
 //! 3. **The forward jump** on that frame, facing forward with the key held: standing, `p = 0.5`, so the
@@ -14,7 +14,7 @@
 //!    view turned 180 degrees over [`AbhParams::turn_frames`] frames.
 //! 5. **Backhops**: on every frame that starts on the ground, jump and duck held, no movement keys, facing
 //!    backwards: ducked, `Fm = 0`, `p = 0.1`, so the boost adds `|v| - 1.1 Mx` along the travel direction
-//!    (physics.md section 11). Jump is released in the air, so each jump is a fresh press.
+//!    (docs/physics.md section 11). Jump is released in the air, so each jump is a fresh press.
 //!
 //! **Why the turn schedule does not matter.** With no movement keys held in the air the FME adds nothing
 //! (`M = 0`), so the view direction only acts on the jump frames, through the boost's `f`. The turn is
@@ -22,13 +22,13 @@
 //! `turn_frames` (tested). The backhop frames always face backwards: a turn longer than the first hop is
 //! cut short on landing.
 //!
-//! **Direction control.** The boost adds `add * f`, `f` the flattened view (physics.md section 11). On each
+//! **Direction control.** The boost adds `add * f`, `f` the flattened view (docs/physics.md section 11). On each
 //! jump frame the yaw is chosen so that the velocity's component across the lane after the boost is the one
 //! that brings the hull centre back to the lane's centre line by the next landing (`-e / T`, `e` the
-//! offset from the centre line, `T` the airtime of physics.md section 10). Across-lane speed is set
+//! offset from the centre line, `T` the airtime of docs/physics.md section 10). Across-lane speed is set
 //! exactly, before the per-component `sv_maxvelocity` clamp (which only touches the along-lane component
 //! here), so the clamp cannot spoil it. Facing exactly opposite the velocity, the boost is straight. The
-//! yaws are put on anglemod steps (physics.md section 1) so the engine-exact replay sees the same view.
+//! yaws are put on anglemod steps (docs/physics.md section 1) so the engine-exact replay sees the same view.
 
 use super::{Controller, EngineRun, Simulation, Trace};
 use crate::physics::abh::boost_add_from_keys;
@@ -41,10 +41,10 @@ use std::f64::consts::PI;
 const MAX_LATERAL_UPS: f64 = 50.0;
 /// Slack on the walk-speed threshold, ups: the ground FME reaches `M` only up to rounding.
 const WALK_SPEED_TOL_UPS: f64 = 1e-6;
-/// The ground layer the airtime estimate falls back to, units (physics.md section 3, step 6).
+/// The ground layer the airtime estimate falls back to, units (docs/physics.md section 3, step 6).
 const GROUND_LAYER_UNITS: f64 = 2.0;
 
-/// The knobs of the ABH run (physics.md section 11).
+/// The knobs of the ABH run (docs/physics.md section 11).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct AbhParams {
     /// The forward jump is taken on the first standing ground frame whose speed before it is at least this,
@@ -73,7 +73,7 @@ impl Default for AbhParams {
     }
 }
 
-/// The boost's signed addition along the view, ups (physics.md section 11), as the frame computes it
+/// The boost's signed addition along the view, ups (docs/physics.md section 11), as the frame computes it
 /// ([`boost_add_from_keys`]) with the scene's max speed and duck multiplier.
 pub fn boost_addition(
     vars: &MovementVars,
@@ -92,7 +92,7 @@ pub fn boost_addition(
     )
 }
 
-/// Time from a jump back to the 2-unit ground layer, seconds (physics.md section 10, with the scene's jump
+/// Time from a jump back to the 2-unit ground layer, seconds (docs/physics.md section 10, with the scene's jump
 /// speed `v0` and gravity `g`): `(v0 + sqrt(v0^2 - 4 g)) / g`. `None` without gravity.
 pub fn jump_airtime_s(vars: &MovementVars) -> Option<f64> {
     let (v0, g) = (vars.jump_speed_ups(), vars.gravity);
@@ -109,7 +109,7 @@ pub fn lane_centre_line(scene: &crate::scene::Scene) -> (Vec2, Vec2) {
     (start, dir)
 }
 
-/// The frame-level ABH controller (physics.md section 11). See the module documentation for the run.
+/// The frame-level ABH controller (docs/physics.md section 11). See the module documentation for the run.
 #[derive(Clone, Debug)]
 pub struct Abh {
     params: AbhParams,
@@ -281,7 +281,7 @@ pub fn hops_from_trace(trace: &Trace, tau: f64) -> Vec<HopRecord> {
     hops
 }
 
-/// A frame-level ABH run and its figures (physics.md section 11).
+/// A frame-level ABH run and its figures (docs/physics.md section 11).
 #[derive(Clone, Debug)]
 pub struct AbhRun {
     /// The run in `f64`.

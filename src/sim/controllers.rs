@@ -1,4 +1,4 @@
-//! Controllers: the greedy maximum-acceleration autostrafer TAS tools use today (physics.md section 6),
+//! Controllers: the greedy maximum-acceleration autostrafer TAS tools use today (docs/physics.md section 6),
 //! one-sided strafers, and playback of a planned sequence.
 
 use super::{Controller, Simulation, Trace};
@@ -95,7 +95,7 @@ impl Greedy {
     }
 
     /// The same strafer holding its speed at `cap_ups` once reached: above it, it strafes at the
-    /// speed-preserving angle (physics.md section 8), which turns harder than maximum acceleration. With
+    /// speed-preserving angle (docs/physics.md section 8), which turns harder than maximum acceleration. With
     /// the cap from the radius-speed relation (section 9) it takes corners the greedy speed cannot.
     pub fn with_speed_cap(mut self, cap_ups: f64) -> Self {
         self.speed_cap_ups = Some(cap_ups);

@@ -1,4 +1,4 @@
-//! Simulation of a scene (physics.md sections 3 and 10): one frame loop, [`Simulation::run`], owns the
+//! Simulation of a scene (docs/physics.md sections 3 and 10): one frame loop, [`Simulation::run`], owns the
 //! walls, the rule lines, the finish line and the frame cap; [`Controller`]s only choose each frame's
 //! control (as argmin's `Solver` leaves the loop to its `Executor`).
 //!
@@ -104,7 +104,7 @@ impl<'s> Simulation<'s> {
         }
     }
 
-    /// Plays `controls` in the engine-exact mode (f32 state, anglemod yaw; physics.md section 1) through the
+    /// Plays `controls` in the engine-exact mode (f32 state, anglemod yaw; docs/physics.md section 1) through the
     /// same walls, rule lines and finish line. The walls are queried in f64 on the f32 positions.
     pub fn run_engine_exact(&self, controls: &[Control]) -> EngineRun {
         use crate::physics::engine_exact::{engine_wish, from_engine_state, to_engine_state};
