@@ -280,7 +280,7 @@ fn radius(engine: &EngineFlags, speed: f64) -> Result<Figures> {
              radius (source text's relation): {source:.4} units\n\
              radius (circle through 3 simulated positions): {measured:.4} units\n\
              radius (first order tau v'^2/(mu sin theta)): {:.4} units\n\
-             the relation gives {:.3} times the measured radius (physics.md section 9)\n",
+             the relation gives {:.3} times the measured radius (docs/physics.md section 9)\n",
             vars.fps,
             r.theta_rad.to_degrees(),
             r.mu,

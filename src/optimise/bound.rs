@@ -164,7 +164,7 @@ pub fn time_to_cover(
     None
 }
 
-/// The schedule-aware bound of a scene with gravity, jumps and the Source jump boost (physics.md
+/// The schedule-aware bound of a scene with gravity, jumps and the Source jump boost (docs/physics.md
 /// sections 3, 10, 11), far tighter than [`time_to_cover`]'s profile, which lets the boost fire on any
 /// frame. It uses what the flat floor fixes whatever the controls:
 /// - the vertical motion depends on the jump frames only (gravity, the jump speed, the 2-unit ground

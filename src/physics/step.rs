@@ -304,7 +304,7 @@ impl<R: Real> Stepper<R> {
         }
     }
 
-    /// The airborne-only frame: steps 4 and 5 of physics.md section 3 and nothing else.
+    /// The airborne-only frame: steps 4 and 5 of docs/physics.md section 3 and nothing else.
     #[inline]
     fn air_step(&self, s: &mut PlayerState<R>, w: &Wish<R>) {
         if self.effects.has(Effect::MaxVelocity) {

@@ -51,7 +51,7 @@ impl Preset {
 pub const GOLDSRC_JUMP_SPEED_UPS: f64 = 268.328_157_299_974_8;
 /// Source's jump height `GAMEMOVEMENT_JUMP_HEIGHT`, units: jump speed is `sqrt(2 g * 21)`.
 pub const SOURCE_JUMP_HEIGHT_UNITS: f64 = 21.0;
-/// Bunnyhop cap threshold, a multiple of `sv_maxspeed` (physics.md section 10).
+/// Bunnyhop cap threshold, a multiple of `sv_maxspeed` (docs/physics.md section 10).
 pub const BHOP_CAP_FACTOR: f64 = 1.7;
 /// Speed after the bunnyhop cap, a multiple of `sv_maxspeed` (`1.7 * 0.65`).
 pub const BHOP_CAP_RESULT_FACTOR: f64 = 1.105;
@@ -181,7 +181,7 @@ impl MovementVars {
         }
     }
 
-    /// The vertical speed a jump sets, ups (physics.md section 2): `sqrt(2*800*45)` in GoldSrc (the game
+    /// The vertical speed a jump sets, ups (docs/physics.md section 2): `sqrt(2*800*45)` in GoldSrc (the game
     /// hard-codes 800), `sqrt(2 g 21)` in Source.
     pub fn jump_speed_ups(&self) -> f64 {
         match self.game {
