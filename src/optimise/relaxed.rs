@@ -8,6 +8,7 @@ use super::model::{rollout_knots, FrameControl};
 use super::planner::Planner;
 use super::scp::{model_crossing, ScpProblem};
 use super::search::Progress;
+use crate::sim::Crossing;
 
 /// Times a relaxed stage that stopped at its iteration cap without a clean crossing is continued at the
 /// same count before the count is given up.
@@ -220,68 +221,90 @@ pub struct RelaxedCertificate {
 pub(super) struct CertifiedPlan {
     pub(super) controls: Vec<FrameControl>,
     pub(super) start_index: usize,
+    crossing: Crossing,
 }
 
-/// The relaxed certificate from `starts` (warm starts, each cut near its crossing), tried in order while
-/// time is left; no plan crosses before frame `lo`. The first start is the planning stage's relaxed plan
-/// and is refined frame by frame; the others go coarse to fine. Returns the certificate and its fastest
-/// plan.
-pub(super) fn certify(
-    planner: &mut Planner,
-    progress: &mut dyn FnMut(Progress),
-    starts: Vec<Vec<FrameControl>>,
-    lo: usize,
-) -> Option<(RelaxedCertificate, CertifiedPlan)> {
-    let mut tried = 0;
-    let mut times: Vec<f64> = Vec::new();
-    let mut best: Option<(crate::sim::Crossing, CertifiedPlan)> = None;
-    for (i, start) in starts.into_iter().enumerate() {
+/// The certificate as its starts are solved: what each start reached and the fastest plan.
+#[derive(Default)]
+pub(super) struct Certifier {
+    tried: usize,
+    times: Vec<f64>,
+    best: Option<CertifiedPlan>,
+}
+
+/// How a start of the certificate is solved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum StartKind {
+    /// A line already planned frame by frame (the relaxed stage's, or the final plan): refined at its
+    /// frame count and below; it is itself a point of the certificate's problem.
+    Planned,
+    /// A greedy run: coarse to fine, as the relaxed stage.
+    Greedy,
+}
+
+impl Certifier {
+    /// Solves the certificate's problem from `start` (planning controls cut near their crossing); no plan
+    /// crosses before frame `lo`. Does nothing once time is up.
+    pub(super) fn add_start(
+        &mut self,
+        planner: &mut Planner,
+        progress: &mut dyn FnMut(Progress),
+        start: Vec<FrameControl>,
+        kind: StartKind,
+        lo: usize,
+    ) {
         if planner.out_of_time() {
-            break;
+            return;
         }
-        tried += 1;
+        let index = self.tried;
+        self.tried += 1;
         let n = start.len();
-        // The first start, the planning stage's relaxed line, is itself a point of the certificate's
-        // problem (it keeps a wider margin).
-        let start_crossing = if i == 0 {
-            planner.crossing_of(&start)
-        } else {
-            None
+        let own = match kind {
+            StartKind::Planned => planner.crossing_of(&start).map(|c| (c, start.clone())),
+            StartKind::Greedy => None,
         };
         let relaxation = Relaxation::certificate();
-        let plan = if i == 0 {
-            count_search(planner, progress, start, n, lo, relaxation, 1)
-        } else {
-            relaxed_plan(planner, progress, start, n, lo, relaxation)
+        let solved = match kind {
+            StartKind::Planned => count_search(planner, progress, start, n, lo, relaxation, 1),
+            StartKind::Greedy => relaxed_plan(planner, progress, start, n, lo, relaxation),
+        }
+        .and_then(|p| planner.crossing_of(&p).map(|c| (c, p)));
+        let reached = match (solved, own) {
+            (Some(s), Some(o)) => Some(if o.0.time < s.0.time { o } else { s }),
+            (s, o) => s.or(o),
         };
-        let solved = plan.and_then(|p| planner.crossing_of(&p).map(|c| (c, p)));
-        let (crossing, plan) = match (solved, start_crossing) {
-            (Some((c, p)), Some(s)) if s.time < c.time => (s, p),
-            (Some(x), _) => x,
-            (None, Some(s)) => (s, Vec::new()),
-            (None, None) => continue,
+        let Some((crossing, controls)) = reached else {
+            return;
         };
-        times.push(crossing.time);
-        if best.as_ref().is_none_or(|(b, _)| crossing.time < b.time) {
-            best = Some((
+        self.times.push(crossing.time);
+        if self
+            .best
+            .as_ref()
+            .is_none_or(|b| crossing.time < b.crossing.time)
+        {
+            self.best = Some(CertifiedPlan {
+                controls,
+                start_index: index,
                 crossing,
-                CertifiedPlan {
-                    controls: plan,
-                    start_index: i,
-                },
-            ));
+            });
         }
     }
-    let (crossing, plan) = best?;
-    let slowest = times.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    Some((
-        RelaxedCertificate {
-            frames: crossing.frames,
-            time: crossing.time,
-            starts: tried,
-            reached: times.len(),
-            spread: slowest - crossing.time,
-        },
-        plan,
-    ))
+
+    /// The fastest relaxed plan so far.
+    pub(super) fn best(&self) -> Option<&CertifiedPlan> {
+        self.best.as_ref()
+    }
+
+    /// The certificate, if any start reached the line.
+    pub(super) fn certificate(&self) -> Option<RelaxedCertificate> {
+        let best = self.best.as_ref()?;
+        let slowest = self.times.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        Some(RelaxedCertificate {
+            frames: best.crossing.frames,
+            time: best.crossing.time,
+            starts: self.tried,
+            reached: self.times.len(),
+            spread: slowest - best.crossing.time,
+        })
+    }
 }

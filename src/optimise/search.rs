@@ -17,7 +17,9 @@ use super::baseline::{baseline, GreedyGuide, GuideRun};
 use super::model::FrameControl;
 use super::planner::Planner;
 use super::polish::rounded_and_polished;
-use super::relaxed::{certify, count_search, relaxed_plan, Relaxation, RelaxedCertificate};
+use super::relaxed::{
+    count_search, relaxed_plan, Certifier, Relaxation, RelaxedCertificate, StartKind,
+};
 use super::verify::{time_of, PlanPlayer};
 use super::{lower_bound, LowerBound};
 use crate::error::{Error, Result};
@@ -389,40 +391,42 @@ fn solve_once(
     } else {
         &[]
     };
-    let starts: Vec<Vec<FrameControl>> = std::iter::once(relaxed.clone())
-        .chain(others.iter().map(|r| planner.warm_start(&r.trace)))
-        .take(settings.certificate_starts)
-        .collect();
-    let certified = certify(&mut planner, progress, starts, lo);
+    let mut certifier = Certifier::default();
+    certifier.add_start(
+        &mut planner,
+        progress,
+        relaxed.clone(),
+        StartKind::Planned,
+        lo,
+    );
+    for run in others
+        .iter()
+        .take(settings.certificate_starts.saturating_sub(1))
+    {
+        let warm = planner.warm_start(&run.trace);
+        certifier.add_start(&mut planner, progress, warm, StartKind::Greedy, lo);
+    }
     // Where another start found a faster relaxed line, that line is planned too.
     let mut sources = vec![(relaxed, relaxed_margin)];
-    if let Some((_, plan)) = certified.as_ref().filter(|(_, p)| p.start_index > 0) {
-        let n = plan.controls.len();
+    if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
+        let (controls, n) = (plan.controls.clone(), plan.controls.len());
         let relaxation = Relaxation::planning(relaxed_margin);
-        if let Some(r) = count_search(
-            &mut planner,
-            progress,
-            plan.controls.clone(),
-            n,
-            lo,
-            relaxation,
-            1,
-        ) {
+        if let Some(r) = count_search(&mut planner, progress, controls, n, lo, relaxation, 1) {
             sources.push((r, relaxed_margin));
         }
     }
     progress(Progress::Finishing);
     // Stages 3 and 4, first with the settings' final margin; if no plan stays valid through rounding and
     // quantisation (a tight margin along a long wall), again with wider ones.
-    let mut best: Option<(f64, Trace)> = None;
+    let mut best: Option<(f64, Trace, Vec<FrameControl>)> = None;
     for final_margin in FINAL_MARGIN_FACTORS.map(|f| f * settings.margin_units) {
         for (relaxed, margin) in &sources {
             let candidates = rounded_and_polished(&mut planner, relaxed, *margin, final_margin);
             for plan in candidates {
-                if let Some((t, trace)) = quantised_and_verified(&planner, plan) {
+                if let Some((t, trace)) = quantised_and_verified(&planner, plan.clone()) {
                     let limit = best.as_ref().map_or(time_of(greedy), |b| b.0);
                     if t < limit {
-                        best = Some((t, trace));
+                        best = Some((t, trace, plan));
                     }
                 }
             }
@@ -431,10 +435,15 @@ fn solve_once(
             break;
         }
     }
+    // The final plan is a point of the certificate's problem too: the last start, so that the certificate
+    // is never behind the plan where the relaxed stage stopped short of its optimum.
+    if let Some((_, _, plan)) = &best {
+        certifier.add_start(&mut planner, progress, plan.clone(), StartKind::Planned, lo);
+    }
     let stats = planner.stats;
-    let relaxed = certified.map(|(c, _)| c);
+    let relaxed = certifier.certificate();
     let outcome = match best {
-        Some((t, trace)) => {
+        Some((t, trace, _)) => {
             let status = if planner.timed_out {
                 SearchStatus::TimeLimit
             } else {
