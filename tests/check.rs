@@ -299,6 +299,23 @@ fn refusals_pass_with_their_message_and_fail_when_the_scene_loads() {
         "{text}"
     );
     assert!(text.contains("1 passed, 2 failed, 0 errors"), "{text}");
+    // --update sets the refusal that changed; the scene that loads stays a failure.
+    let out = check_in(&dir, &["--update", "."]);
+    assert_eq!(out.status.code(), Some(1), "{}", stdout(&out));
+    assert!(
+        stdout(&out).contains("2 passed, 1 failed, 0 errors, 0 skipped, 1 updated"),
+        "{}",
+        stdout(&out)
+    );
+    let other = read(&dir.join("c-other-message.toml"));
+    assert!(
+        other.ends_with("error = \"engine.fps: got -1; must be a finite number above 0\"\n"),
+        "{other}"
+    );
+    assert_eq!(
+        read(&dir.join("b-accepted.toml")),
+        format!("{BEND}\n[expect]\nerror = \"engine.fps\"\n")
+    );
 }
 
 #[test]

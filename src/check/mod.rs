@@ -32,7 +32,7 @@ pub struct Measured {
     pub frames: Option<u64>,
     /// The fractional crossing time, seconds.
     pub time_s: Option<f64>,
-    /// `100 (time - bound) / bound`, percent (physics.md section 6 for the bound).
+    /// `100 (time - bound) / bound`, percent (the bound: docs/physics.md section 6).
     pub gap_percent: Option<f64>,
     /// The run reached the line without breaking a rule.
     pub valid: bool,

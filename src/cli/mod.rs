@@ -1,6 +1,7 @@
 //! The command line: a thin layer over the library. Parses arguments, resolves them into library values,
 //! prints the result, and maps errors to exit codes: 0 done, 2 bad input (usage, file, value), 3 no valid
-//! path through the scene, 1 anything else (for `check`: a regression). Every error is one line on stderr behind `strafeopt: `.
+//! path through the scene, 1 anything else (for `check`: a regression). Every error is one line on stderr
+//! behind `strafeopt: `.
 
 pub mod args;
 pub mod bench;
