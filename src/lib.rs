@@ -3,9 +3,11 @@
 //! Data flows one way: [`scene`] -> simulation -> [`optimise`] -> reports. [`physics`] is the algebra
 //! layer under all of them; [`geometry`] holds the corridor and the swept player hull, and the scene's
 //! walls and finish line are geometry's types, so scene validation and simulation agree on contact.
+//! [`check`] runs scenes against the expectations their files carry (scenario regression tests).
 #![warn(missing_docs)]
 
 pub mod bench;
+pub mod check;
 pub mod cli;
 pub mod error;
 pub mod geometry;

@@ -26,6 +26,27 @@ pub enum Command {
     Report(ReportArgs),
     /// Measure what accuracy costs in time: every level from the lower bound to the engine-exact plan.
     Bench(super::bench::BenchArgs),
+    /// Run every scene that carries an [expect] table and report whether a result got worse.
+    Check(CheckArgs),
+}
+
+/// `strafeopt check [PATHS...]`
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Scene files, or folders searched recursively for `*.toml` (default: the current folder).
+    pub paths: Vec<PathBuf>,
+    /// Scenes checked at once (default: the number of cores).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
+    pub jobs: Option<u16>,
+    /// Rewrite each scene's [expect] values from the current results (comments and layout kept).
+    #[arg(long)]
+    pub update: bool,
+    /// Also write a JUnit XML report.
+    #[arg(long)]
+    pub junit: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub output: OutputFlags,
 }
 
 /// Output files every run can write besides `--trajectory`.

@@ -1,10 +1,12 @@
 //! The command line: a thin layer over the library. Parses arguments, resolves them into library values,
 //! prints the result, and maps errors to exit codes: 0 done, 2 bad input (usage, file, value), 3 no valid
-//! path through the scene, 1 anything else. Every error is one line on stderr behind `strafeopt: `.
+//! path through the scene, 1 anything else (for `check`: a regression). Every error is one line on stderr
+//! behind `strafeopt: `.
 
 pub mod args;
 pub mod bench;
 pub mod calc;
+pub mod check;
 pub mod report_cmd;
 pub mod simulate;
 pub mod solve;
@@ -68,16 +70,20 @@ pub fn main_with_args(argv: impl IntoIterator<Item = std::ffi::OsString>) -> u8 
             return EXIT_BAD_INPUT;
         }
     };
-    match run(&cli) {
-        Ok(out) => {
+    let result = match &cli.command {
+        Command::Check(a) => check::run(a),
+        _ => run(&cli).map(|out| (out, EXIT_OK)),
+    };
+    match result {
+        Ok((out, code)) => {
             let mut stdout = std::io::stdout().lock();
             match stdout
                 .write_all(out.as_bytes())
                 .and_then(|_| stdout.flush())
             {
-                Ok(()) => EXIT_OK,
+                Ok(()) => code,
                 // A closed pipe (`| head`) is not a failure.
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => EXIT_OK,
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => code,
                 Err(e) => {
                     eprintln!("strafeopt: writing the output: {e}");
                     EXIT_FAILURE
@@ -121,6 +127,7 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
         Command::Solve(a) => solve::run(a),
         Command::Report(a) => report_cmd::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Check(a) => check::run(a).map(|(out, _)| out),
         Command::Calc(c) => {
             let figures = calc::run(&c.form)?;
             if calc::wants_json(&c.form) {

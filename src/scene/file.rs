@@ -1,6 +1,7 @@
 //! The scene file as written: raw values, checked only for keys and types ([`SceneFile`]). Every key is
 //! kebab-case and unknown keys are refused.
 
+use super::expect::ExpectFile;
 use super::shorthand::{Bend90, Hairpin, Lane};
 use crate::geometry::{BoundaryKind, FinishPoint};
 use crate::physics::{Effect, Preset, VarOverrides, Vec2};
@@ -42,6 +43,9 @@ pub struct SceneFile {
     /// `[lane]`: a straight lane.
     #[serde(default)]
     pub lane: Option<Lane>,
+    /// `[expect]`: what `strafeopt check` runs and what must hold (never seen by the simulation).
+    #[serde(default)]
+    pub expect: Option<ExpectFile>,
 }
 
 /// `[engine]`: `preset`, `effects`, and any field of [`VarOverrides`] (`fps = 100`, `airaccelerate = 100`).

@@ -26,6 +26,10 @@
 //! leg1 = 1200
 //! leg2 = 1200
 //! kind = "rule"
+//! [expect]                           # optional: what `strafeopt check` runs and what must hold
+//! command = "solve"                  # see the `expect` module
+//! quality = "fast"
+//! frames = 401
 //! ```
 //!
 //! Every error is one line, `file:line: key: what is wrong; what is allowed`
@@ -38,13 +42,16 @@
 //!
 //! [`geometry`]: crate::geometry
 
+pub mod expect;
 mod file;
 mod locate;
 pub mod shorthand;
 mod validate;
 
 pub use crate::geometry::{BoundaryKind, FinishLine, FinishPoint, Wall};
+pub use expect::{expectation_from_str, Expectation, ExpectedRun, Limits};
 pub use file::{EngineFile, FinishFile, Point, SceneFile, StartFile, WallFile};
+pub(crate) use locate::one_line;
 pub use shorthand::{Bend90, Hairpin, Lane, START_OFFSET_UNITS};
 
 use crate::error::{Error, Result};
@@ -65,6 +72,15 @@ pub const MAX_COORDINATE_UNITS: f64 = 1e6;
 /// Largest start speed, ups: far beyond any reachable speed (`sv_maxvelocity` clamps each component at 2000
 /// ups in Half-Life, 3500 in Half-Life 2), and small enough that no position of a run overflows.
 pub const MAX_START_SPEED_UPS: f64 = 1e6;
+
+/// The text of a scene file. A file that cannot be read is an [`Error::Scene`] naming the path.
+pub fn read_text(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| Error::Scene {
+        location: locate::one_line(&path.display().to_string()),
+        key: "-".to_string(),
+        message: format!("cannot read the file: {e}"),
+    })
+}
 
 /// A validated scene: everything a simulation needs.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -100,13 +116,8 @@ impl Scene {
 
     /// Reads and validates a scene file. A file that cannot be read is an [`Error::Scene`] naming the path.
     pub fn load(path: &Path) -> Result<Scene> {
-        let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Scene {
-            location: locate::one_line(&origin),
-            key: "-".to_string(),
-            message: format!("cannot read the file: {e}"),
-        })?;
-        Scene::from_toml_str(&text, &origin)
+        let text = read_text(path)?;
+        Scene::from_toml_str(&text, &path.display().to_string())
     }
 
     /// The corridor of this scene's walls (valid by construction of a loaded scene).

@@ -30,6 +30,10 @@ struct Shape {
 }
 
 fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
+    // The expectations are checked like any table, then left to `strafeopt check`.
+    if let Some(expect) = &file.expect {
+        super::expect::validate(expect, ix)?;
+    }
     let shape = shorthand(&file, ix)?;
 
     // Engine: preset + overrides, then effects (docs/physics.md sections 2, 3).
