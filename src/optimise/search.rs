@@ -28,18 +28,20 @@ use super::model::{
 };
 use super::qp::{self, SubProblem, SubStepStatus, WallRow};
 use super::{lower_bound, LowerBound};
+use crate::budget::{Budget, Stage, Stop};
 use crate::error::{Error, Result};
 use crate::geometry::{Corridor, Separation, HULL_HALF_WIDTH_UNITS};
 use crate::physics::curvature::{air_law, bend_arc_radius, speed_for_radius};
 use crate::physics::engine_exact::{anglemod_bracket, quantise_yaw_rad};
 use crate::physics::{Control, PlayerState, Vec2};
 use crate::scene::Scene;
-use crate::sim::controllers::{best_capped_greedy, Greedy, GREEDY_LOOKAHEADS_UNITS};
+use crate::sim::controllers::{best_capped_greedy_within, Greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{Controller, EngineRun, Simulation, Trace};
 use argmin::core::{
     CostFunction, Error as ArgminError, Executor, IterState, Problem, Solver, State,
     TerminationReason, TerminationStatus, KV,
 };
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 /// How hard `solve` works.
@@ -73,6 +75,9 @@ pub struct SearchSettings {
     pub wall_radius_units: f64,
     /// Stop with the best valid plan after this long.
     pub time_limit: Option<Duration>,
+    /// Most frames a run is planned over: a scene whose lower bound needs more is refused
+    /// ([`Error::FrameLimit`]), and no simulated run goes further (the scene's own cap, if lower, holds).
+    pub max_frames: u64,
 }
 
 impl SearchSettings {
@@ -87,6 +92,7 @@ impl SearchSettings {
             slack_weight: 100.0,
             wall_radius_units: 40.0,
             time_limit: None,
+            max_frames: crate::budget::DEFAULT_MAX_PLANNED_FRAMES,
         };
         match quality {
             Quality::Fast => SearchSettings {
@@ -122,8 +128,16 @@ pub enum SearchStatus {
         /// `(time - bound) / bound`.
         gap: f64,
     },
-    /// The time limit stopped it; the best valid plan so far is returned.
-    TimeLimit,
+    /// The time limit stopped it in `stopped_in`; the best valid plan so far is returned.
+    TimeLimit {
+        /// The stage that was cut.
+        stopped_in: Stage,
+    },
+    /// The caller's cancel flag stopped it in `stopped_in`; the best valid plan so far is returned.
+    Cancelled {
+        /// The stage that was cut.
+        stopped_in: Stage,
+    },
     /// The scene uses effects the optimiser does not plan (ground, gravity, jumps): the greedy run is
     /// returned.
     GreedyOnly {
@@ -137,15 +151,40 @@ pub enum SearchStatus {
     },
 }
 
+impl SearchStatus {
+    /// The status of a search cut by `budget` in `stage` (the time limit unless the cancel flag is set).
+    pub fn stopped(budget: &Budget, stage: Stage) -> Self {
+        match budget.stop() {
+            Some(Stop::Cancelled) => SearchStatus::Cancelled { stopped_in: stage },
+            _ => SearchStatus::TimeLimit { stopped_in: stage },
+        }
+    }
+
+    /// The stage a budget cut, if one was.
+    pub fn stopped_in(&self) -> Option<Stage> {
+        match self {
+            SearchStatus::TimeLimit { stopped_in } | SearchStatus::Cancelled { stopped_in } => {
+                Some(*stopped_in)
+            }
+            _ => None,
+        }
+    }
+}
+
 impl std::fmt::Display for SearchStatus {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             SearchStatus::Converged { gap } => {
                 write!(f, "converged, {:.3}% above the lower bound", 100.0 * gap)
             }
-            SearchStatus::TimeLimit => {
-                f.write_str("stopped by the time limit with the best valid plan so far")
-            }
+            SearchStatus::TimeLimit { stopped_in } => write!(
+                f,
+                "stopped by the time limit in the {stopped_in} stage, with the best valid plan so far"
+            ),
+            SearchStatus::Cancelled { stopped_in } => write!(
+                f,
+                "cancelled in the {stopped_in} stage, with the best valid plan so far"
+            ),
             SearchStatus::GreedyOnly { reason } => write!(f, "greedy plan returned: {reason}"),
             SearchStatus::NoImprovement { reason } => write!(f, "greedy plan returned: {reason}"),
         }
@@ -330,7 +369,8 @@ type ScpState = IterState<Vec<f64>, (), (), (), (), f64>;
 
 /// One SCP iteration per argmin iteration: linearise, solve the Clarabel sub-problem, accept the step
 /// only if exact re-simulation confirms enough of the predicted gain.
-pub struct ScpSolver {
+pub struct ScpSolver<'c> {
+    budget: Budget<'c>,
     trust: f64,
     sigma_trust: f64,
     c_trust_ups: f64,
@@ -342,9 +382,10 @@ pub struct ScpSolver {
     duals: Option<Vec<[f64; 4]>>,
 }
 
-impl ScpSolver {
-    fn new(tol: f64) -> Self {
+impl<'c> ScpSolver<'c> {
+    fn new(tol: f64, budget: Budget<'c>) -> Self {
         ScpSolver {
+            budget,
             trust: 1.0,
             sigma_trust: 0.1,
             c_trust_ups: 5.0,
@@ -374,7 +415,7 @@ const MERIT_MARGIN_SHARE: f64 = 0.5;
 /// Least share of the predicted gain a step must deliver to be accepted.
 const ACCEPT_RATIO: f64 = 0.1;
 
-impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
+impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
     fn name(&self) -> &str {
         "scp-clarabel"
     }
@@ -512,6 +553,8 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
     fn terminate(&mut self, _state: &ScpState) -> TerminationStatus {
         if self.converged || self.trust < self.min_trust {
             TerminationStatus::Terminated(TerminationReason::SolverConverged)
+        } else if self.budget.expired() {
+            TerminationStatus::Terminated(TerminationReason::Interrupt)
         } else {
             TerminationStatus::NotTerminated
         }
@@ -525,12 +568,12 @@ fn run_scp(
     controls: Vec<FrameControl>,
     max_iters: u64,
     tol: f64,
-    deadline: Option<Instant>,
+    budget: Budget,
 ) -> (Vec<FrameControl>, bool, bool, SearchStats) {
     let x0 = pack(&controls);
-    let mut exec = Executor::new(problem, ScpSolver::new(tol))
+    let mut exec = Executor::new(problem, ScpSolver::new(tol, budget))
         .configure(|s| s.param(x0.clone()).max_iters(max_iters));
-    if let Some(d) = deadline {
+    if let Some(d) = budget.deadline() {
         exec = exec.timeout(
             d.saturating_duration_since(Instant::now())
                 .max(Duration::from_millis(1)),
@@ -539,7 +582,10 @@ fn run_scp(
     match exec.run() {
         Ok(res) => {
             let reason = res.state().get_termination_reason();
-            let timed_out = matches!(reason, Some(TerminationReason::Timeout));
+            let timed_out = matches!(
+                reason,
+                Some(TerminationReason::Timeout | TerminationReason::Interrupt)
+            );
             let capped = matches!(reason, Some(TerminationReason::MaxItersReached));
             let best = res
                 .state()
@@ -565,7 +611,7 @@ fn scp_stage(
     controls: Vec<FrameControl>,
     max_iters: u64,
     settings: &SearchSettings,
-    deadline: Option<Instant>,
+    budget: Budget,
     stats: &mut SearchStats,
     timed_out: &mut bool,
 ) -> (Vec<FrameControl>, bool) {
@@ -574,7 +620,7 @@ fn scp_stage(
         controls,
         max_iters,
         settings.tol_progress_units,
-        deadline,
+        budget,
     );
     add_stats(stats, s);
     *timed_out |= t;
@@ -612,13 +658,22 @@ const ROUNDING_BEAM: usize = 64;
 /// its heading error would drift over a short horizon. Rounding frame by frame keeps the heading error
 /// bounded but not zero-mean where the relaxed sides saturate, and a steady heading error of a few
 /// hundredths of a radian drifts the path by tens of units.
-fn round_sides(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw) -> Vec<FrameControl> {
+/// `None` when `budget` runs out first.
+fn round_sides(
+    start: &ModelState,
+    controls: &[FrameControl],
+    fl: &FrameLaw,
+    budget: &Budget,
+) -> Option<Vec<FrameControl>> {
     let relaxed = rollout(start, controls, fl);
     let horizon_s = ROUNDING_HORIZON_S;
     // Beam entries: (cost, state, index into the history of choices).
     let mut history: Vec<(usize, f64)> = Vec::with_capacity(controls.len() * ROUNDING_BEAM * 2);
     let mut beam: Vec<(f64, ModelState, usize)> = vec![(0.0, *start, usize::MAX)];
     for (k, u) in controls.iter().enumerate() {
+        if k as u64 % crate::budget::FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
+            return None;
+        }
         let target = relaxed[k];
         let mut next: Vec<(f64, ModelState, usize)> = Vec::with_capacity(beam.len() * 2);
         for &(cost, x, h) in &beam {
@@ -642,11 +697,13 @@ fn round_sides(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw) -> 
         h = parent;
     }
     sides.reverse();
-    controls
-        .iter()
-        .zip(sides)
-        .map(|(u, sigma)| FrameControl { sigma, c: u.c })
-        .collect()
+    Some(
+        controls
+            .iter()
+            .zip(sides)
+            .map(|(u, sigma)| FrameControl { sigma, c: u.c })
+            .collect(),
+    )
 }
 
 /// Plays planning controls through the real frame, recomputing each frame's yaw from the actual velocity.
@@ -765,8 +822,36 @@ pub fn solve_with_progress(
     settings: &SearchSettings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome> {
+    solve_within(scene, settings, progress, Budget::from_limit(settings.time_limit, None))
+}
+
+/// [`solve_with_progress`] that also stops when `cancel` is set: a set flag acts like the time limit
+/// expiring at once, in whatever stage is running. The best valid plan so far is returned with status
+/// [`SearchStatus::Cancelled`] naming that stage; [`Error::Stopped`] when nothing valid was found yet.
+/// For callers that replace a solve by a newer one (an editor re-solving after every edit).
+pub fn solve_cancellable(
+    scene: &Scene,
+    settings: &SearchSettings,
+    progress: &mut dyn FnMut(Progress),
+    cancel: &AtomicBool,
+) -> Result<Outcome> {
+    solve_within(
+        scene,
+        settings,
+        progress,
+        Budget::from_limit(settings.time_limit, Some(cancel)),
+    )
+}
+
+/// The solve of every entry point, within `budget` (which covers every level run).
+fn solve_within(
+    scene: &Scene,
+    settings: &SearchSettings,
+    progress: &mut dyn FnMut(Progress),
+    budget: Budget,
+) -> Result<Outcome> {
     let started = Instant::now();
-    let mut best = solve_once(scene, settings, progress)?;
+    let mut best = solve_once(scene, settings, budget, progress)?;
     if !scene.effects.is_air_only() {
         return Ok(best);
     }
@@ -777,24 +862,32 @@ pub fn solve_with_progress(
     };
     let mut stats = best.stats;
     for &quality in lower {
-        let time_limit = match settings.time_limit {
-            Some(limit) => match limit.checked_sub(started.elapsed()) {
-                Some(left) if !left.is_zero() => Some(left),
-                _ => break,
-            },
-            None => None,
-        };
+        if budget.expired() {
+            break;
+        }
         let other = solve_once(
             scene,
             &SearchSettings {
-                time_limit,
+                time_limit: settings.time_limit,
+                max_frames: settings.max_frames,
                 ..SearchSettings::for_quality(quality)
             },
+            budget,
             progress,
-        )?;
+        );
+        // A lower level cut before it had anything valid leaves the plan already found.
+        let other = match other {
+            Err(Error::Stopped { .. }) => break,
+            other => other?,
+        };
         add_stats(&mut stats, other.stats);
         if other.source == "optimised" && time_of(&other.trace) < time_of(&best.trace) {
             best = other;
+        } else if best.status.stopped_in().is_none() {
+            // The plan kept is this level's, but the time limit (or cancel flag) cut the run after it.
+            if let Some(stage) = other.status.stopped_in() {
+                best.status = SearchStatus::stopped(&budget, stage);
+            }
         }
     }
     // The work of every run.
@@ -807,12 +900,28 @@ pub fn solve_with_progress(
 fn solve_once(
     scene: &Scene,
     settings: &SearchSettings,
+    budget: Budget,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome> {
     let started = Instant::now();
-    let deadline = settings.time_limit.map(|d| started + d);
+    let bound = lower_bound(scene, &scene.corridor()?)?;
+    if bound.crossing.frames > settings.max_frames {
+        return Err(Error::FrameLimit {
+            scene: scene.origin.clone(),
+            frames: bound.crossing.frames,
+            limit: settings.max_frames,
+        });
+    }
+    // No run goes past the frame limit: the memory of a run (and of every stage after it) grows with its
+    // frames.
+    let scene = &Scene {
+        max_frames: scene.max_frames.min(settings.max_frames),
+        ..scene.clone()
+    };
     let sim = Simulation::new(scene)?;
-    let bound = lower_bound(scene, sim.corridor())?;
+    if budget.expired() {
+        return Err(Error::stopped(budget.stop(), Stage::LowerBound));
+    }
     let fl = FrameLaw {
         tau_s: scene.frame_time_s(),
         law: air_law(&scene.vars),
@@ -824,12 +933,13 @@ fn solve_once(
         .iter()
         .filter_map(|&w| speed_for_radius(&scene.vars, bend_arc_radius(w)).ok())
         .collect();
-    let (greedy, _, _) = best_greedy_or_capped(&sim, &bound, &caps, scene.effects.is_air_only());
+    let (greedy, _, _) =
+        best_greedy_or_capped(&sim, &bound, &caps, scene.effects.is_air_only(), &budget);
     // The search's start: the greedy run if it is valid and touches no wall (the planning model has no
     // collisions: after a contact the model and the game part ways), else a run along a centred guide.
     let clean = |t: &Trace| t.feasible() && t.crossing.is_some() && t.collisions() == 0;
-    let seed = if scene.effects.is_air_only() && !clean(&greedy) {
-        centred_greedy(&sim, scene, &caps, &clean)
+    let seed = if scene.effects.is_air_only() && !clean(&greedy) && !budget.expired() {
+        centred_greedy(&sim, scene, &caps, &clean, &budget)
     } else {
         None
     };
@@ -839,6 +949,11 @@ fn solve_once(
         _ => greedy,
     };
     let seed = seed.unwrap_or_else(|| greedy.clone());
+    // The stage the budget cut, if any (set where each stage notices it).
+    let mut cut_in = budget.expired().then_some(Stage::Greedy);
+    if !greedy.feasible() && cut_in.is_some() {
+        return Err(Error::stopped(budget.stop(), Stage::Greedy));
+    }
     let mut stats = SearchStats::default();
     progress(Progress::Baseline {
         greedy_frames: greedy.crossing.map(|c| c.frames),
@@ -849,7 +964,14 @@ fn solve_once(
                   status: SearchStatus,
                   stats: SearchStats,
                   source: &'static str| {
-        let engine_exact = sim.run_engine_exact(&controls);
+        let engine_exact = sim.run_engine_exact_within(&controls, &budget);
+        // A replay cut short leaves the plan unverified in the engine-exact mode: the status says so.
+        let status = match status {
+            s if engine_exact.interrupted && s.stopped_in().is_none() => {
+                SearchStatus::stopped(&budget, Stage::Verification)
+            }
+            s => s,
+        };
         Outcome {
             controls,
             trace,
@@ -868,12 +990,12 @@ fn solve_once(
     if !scene.effects.is_air_only() {
         // Jumping scenes with the Source boost: the policy search of `jumps` (issue 7). It keeps a plan
         // only if it is valid in f64 and engine-exact; greedy stays the answer when it is faster.
-        if let Some(plan) = super::jumps::plan_jumps(&sim, settings, deadline) {
+        if let Some(plan) = super::jumps::plan_jumps(&sim, settings, budget) {
             stats.iterations = plan.evaluations;
             let t = plan.best.time();
             if t < time_of(&greedy_plan.1) {
                 let status = if plan.timed_out {
-                    SearchStatus::TimeLimit
+                    SearchStatus::stopped(&budget, Stage::Jumps)
                 } else {
                     SearchStatus::Converged {
                         gap: (t - bound.crossing.time) / bound.crossing.time.max(f64::MIN_POSITIVE),
@@ -888,6 +1010,13 @@ fn solve_once(
                     "optimised",
                 ));
             }
+        }
+        if budget.expired() {
+            cut_in = cut_in.or(Some(Stage::Jumps));
+        }
+        if let Some(stage) = cut_in {
+            let status = SearchStatus::stopped(&budget, stage);
+            return Ok(finish(greedy_plan.0, greedy_plan.1, status, stats, "greedy"));
         }
         return Ok(finish(
             greedy_plan.0,
@@ -965,7 +1094,7 @@ fn solve_once(
         start,
         fl,
         settings,
-        deadline,
+        budget,
         stats: &mut stats,
         timed_out: &mut timed_out,
         progress,
@@ -1008,12 +1137,15 @@ fn solve_once(
         }
     }
     let best_relaxed = search.run(&problem, controls, n, lo, relaxed_margin, 1);
+    if timed_out {
+        cut_in = cut_in.or(Some(Stage::Relaxed));
+    }
     let Some(relaxed) = best_relaxed else {
         return Ok(finish(
             greedy_plan.0,
             greedy_plan.1,
-            if timed_out {
-                SearchStatus::TimeLimit
+            if let Some(stage) = cut_in {
+                SearchStatus::stopped(&budget, stage)
             } else {
                 SearchStatus::NoImprovement {
                     reason: "the relaxed search found no valid plan".into(),
@@ -1041,7 +1173,11 @@ fn solve_once(
         let mut relaxed = relaxed_plan.clone();
         let mut margin = relaxed_margin;
         for attempt in 0..=MARGIN_RETRIES {
-            let mut exact = round_sides(&start, &relaxed, &fl);
+            let Some(mut exact) = round_sides(&start, &relaxed, &fl, &budget) else {
+                timed_out = true;
+                cut_in = cut_in.or(Some(Stage::Rounding));
+                break;
+            };
             if settings.polish_iters > 0 && !timed_out {
                 let pr = problem(final_margin, false);
                 let (c, _) = scp_stage(
@@ -1049,7 +1185,7 @@ fn solve_once(
                     exact.clone(),
                     settings.polish_iters,
                     settings,
-                    deadline,
+                    budget,
                     &mut stats,
                     &mut timed_out,
                 );
@@ -1059,6 +1195,9 @@ fn solve_once(
             let clean = problem(final_margin, false).violation(&st) <= 1e-9;
             let reaches = model_crossing(&start, &st, scene).is_some();
             candidates.push(exact);
+            if timed_out {
+                cut_in = cut_in.or(Some(Stage::Rounding));
+            }
             if (clean && reaches) || attempt == MARGIN_RETRIES || timed_out {
                 break;
             }
@@ -1069,7 +1208,7 @@ fn solve_once(
                 relaxed.clone(),
                 settings.relaxed_iters,
                 settings,
-                deadline,
+                budget,
                 &mut stats,
                 &mut timed_out,
             );
@@ -1092,19 +1231,36 @@ fn solve_once(
         }
         // Stage 3: the real frame, quantised yaws, engine-exact check; keep the best valid plan.
         for cand in candidates {
-            let trace = sim.run(&mut PlanPlayer::new(&start, &prefix, cand, fl, true));
+            let trace = sim.run_within(
+                &mut PlanPlayer::new(&start, &prefix, cand, fl, true),
+                &budget,
+            );
             let t = time_of(&trace);
             let controls = trace.controls.clone();
-            if t < best.0 && sim.run_engine_exact(&controls).feasible() {
-                best = (t, controls, trace, "optimised");
+            let verified = || {
+                let run = sim.run_engine_exact_within(&controls, &budget);
+                (run.feasible(), run.interrupted)
+            };
+            if trace.interrupted {
+                timed_out = true;
+                cut_in = cut_in.or(Some(Stage::Verification));
+            } else if t < best.0 {
+                match verified() {
+                    (true, _) => best = (t, controls, trace, "optimised"),
+                    (false, true) => {
+                        timed_out = true;
+                        cut_in = cut_in.or(Some(Stage::Verification));
+                    }
+                    (false, false) => {}
+                }
             }
         }
         if best.3 == "optimised" || timed_out {
             break;
         }
     }
-    let status = if timed_out {
-        SearchStatus::TimeLimit
+    let status = if let Some(stage) = cut_in.filter(|_| timed_out || budget.expired()) {
+        SearchStatus::stopped(&budget, stage)
     } else if best.3 == "greedy" {
         SearchStatus::NoImprovement {
             reason: "no optimised plan stayed valid after rounding and quantisation".into(),
@@ -1143,7 +1299,7 @@ struct CountSearch<'s, 'p> {
     start: ModelState,
     fl: FrameLaw,
     settings: &'s SearchSettings,
-    deadline: Option<Instant>,
+    budget: Budget<'s>,
     stats: &'s mut SearchStats,
     timed_out: &'s mut bool,
     progress: &'p mut dyn FnMut(Progress),
@@ -1168,7 +1324,7 @@ impl CountSearch<'_, '_> {
         let mut grow_tries = 0;
         let mut continue_tries = 0;
         loop {
-            if self.deadline.is_some_and(|d| Instant::now() >= d) {
+            if self.budget.expired() {
                 *self.timed_out = true;
                 break;
             }
@@ -1185,7 +1341,7 @@ impl CountSearch<'_, '_> {
                 controls.clone(),
                 self.settings.relaxed_iters,
                 self.settings,
-                self.deadline,
+                self.budget,
                 self.stats,
                 self.timed_out,
             );
@@ -1237,9 +1393,10 @@ fn best_greedy_or_capped(
     bound: &LowerBound,
     caps: &[f64],
     air_only: bool,
+    budget: &Budget,
 ) -> (Trace, f64, Option<f64>) {
     let caps: &[f64] = if air_only { caps } else { &[] };
-    best_capped_greedy(sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS, caps)
+    best_capped_greedy_within(sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS, caps, budget)
 }
 
 /// Extra clearances of the guide paths, units, tried in turn when the best greedy run is not clean.
@@ -1257,6 +1414,7 @@ fn centred_greedy(
     scene: &Scene,
     caps: &[f64],
     clean: &dyn Fn(&Trace) -> bool,
+    budget: &Budget,
 ) -> Option<Trace> {
     for extra in GUIDE_CLEARANCES_UNITS {
         let Ok(corridor) = Corridor::with_half_width(&scene.walls, HULL_HALF_WIDTH_UNITS + extra)
@@ -1271,13 +1429,24 @@ fn centred_greedy(
         let mut best: Option<Trace> = None;
         for cap in std::iter::once(None).chain(caps.iter().copied().map(Some)) {
             for &la in &GREEDY_LOOKAHEADS_UNITS {
+                if budget.expired() {
+                    return best;
+                }
                 let greedy = Greedy::new(path.clone(), la);
-                let t = sim.run(&mut match cap {
-                    Some(cap) => greedy.with_speed_cap(cap),
-                    None => greedy,
+                let make = || match cap {
+                    Some(cap) => greedy.clone().with_speed_cap(cap),
+                    None => greedy.clone(),
+                };
+                // The verdicts from a run without its frames; only a new best is replayed whole.
+                let run = sim.run_summary(&mut make(), budget);
+                let better = best.as_ref().is_none_or(|b| {
+                    run.crossing.map_or(f64::INFINITY, |c| c.time) < time_of(b)
                 });
-                if clean(&t) && best.as_ref().is_none_or(|b| time_of(&t) < time_of(b)) {
-                    best = Some(t);
+                if run.feasible() && run.collisions == 0 && better {
+                    let t = sim.run(&mut make());
+                    if clean(&t) {
+                        best = Some(t);
+                    }
                 }
             }
         }
