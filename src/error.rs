@@ -59,7 +59,9 @@ pub enum Error {
         limit: u64,
     },
     /// The time limit or the cancel flag stopped the work before any valid result was found.
-    #[error("stopped by {reason} in the {stage} stage before any run reached the finish validly{hint}")]
+    #[error(
+        "stopped by {reason} in the {stage} stage before any run reached the finish validly{hint}"
+    )]
     Stopped {
         /// What stopped it.
         reason: crate::budget::Stop,

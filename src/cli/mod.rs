@@ -218,10 +218,7 @@ pub fn write_artifacts_within(
             }
         })?;
     }
-    let html = artifacts
-        .report
-        .as_ref()
-        .filter(|_| turn("--report", true));
+    let html = artifacts.report.as_ref().filter(|_| turn("--report", true));
     if let Some(path) = html {
         let input = runs.iter().fold(
             report::ReportInput::new(scene, bound, summary),

@@ -50,7 +50,9 @@ pub fn run(args: &SolveArgs) -> Result<String> {
             bar.set_prefix(Stage::Relaxed.name());
             bar.set_message(format!(
                 "frame counts tried {counts_tried}, last {frames}: {}",
-                reached.map_or("not reached".to_string(), |r| format!("crosses in frame {r}"))
+                reached.map_or("not reached".to_string(), |r| format!(
+                    "crosses in frame {r}"
+                ))
             ));
         }
         search::Progress::Finishing => {
@@ -190,7 +192,10 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         scene.preset.name(),
         fps_text(scene.vars.fps)
     );
-    s.push_str(&field("plan", format!("{} ({})", fmt_time(o.trace.crossing), o.source)));
+    s.push_str(&field(
+        "plan",
+        format!("{} ({})", fmt_time(o.trace.crossing), o.source),
+    ));
     s.push_str(&field(
         "engine-exact",
         format!(

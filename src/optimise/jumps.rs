@@ -38,6 +38,7 @@
 //! in the engine-exact mode (f32) before it is accepted.
 
 use super::search::{Quality, SearchSettings};
+use crate::budget::Budget;
 use crate::physics::engine_exact::quantise_yaw_rad;
 use crate::physics::strafe::{max_accel_control, strafe_keys};
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2};
@@ -45,7 +46,6 @@ use crate::sim::abh::{boost_addition, jump_airtime_s, lane_centre_line, run_abh,
 use crate::sim::{Controller, EngineRun, Simulation, Trace};
 use serde::Serialize;
 use std::f64::consts::PI;
-use crate::budget::Budget;
 
 /// Largest speed across the lane the steering asks for, as a share of the speed.
 const MAX_LATERAL_SHARE: f64 = 0.25;
@@ -444,11 +444,7 @@ fn first_ground_tick(sim: &Simulation) -> u64 {
 /// or `None` when the scene cannot jump with the Source boost (no gravity, jump or boost: nothing here
 /// applies) or no candidate reached the line validly. The hand-tuned ABH controller
 /// ([`crate::sim::abh::Abh`]) is one of the candidates, so the plan is never worse than it.
-pub fn plan_jumps(
-    sim: &Simulation,
-    settings: &SearchSettings,
-    budget: Budget,
-) -> Option<JumpPlan> {
+pub fn plan_jumps(sim: &Simulation, settings: &SearchSettings, budget: Budget) -> Option<JumpPlan> {
     let fx = sim.scene().effects;
     if !(fx.has(Effect::Gravity) && fx.has(Effect::Jump) && fx.has(Effect::JumpBoost)) {
         return None;
@@ -652,8 +648,10 @@ mod tests {
         let scene = abh_scene();
         let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
         let settings = SearchSettings::for_quality(Quality::Fast);
-        let a = plan_jumps(&sim, &settings, Budget::unlimited()).unwrap_or_else(|| panic!("a plan"));
-        let b = plan_jumps(&sim, &settings, Budget::unlimited()).unwrap_or_else(|| panic!("a plan"));
+        let a =
+            plan_jumps(&sim, &settings, Budget::unlimited()).unwrap_or_else(|| panic!("a plan"));
+        let b =
+            plan_jumps(&sim, &settings, Budget::unlimited()).unwrap_or_else(|| panic!("a plan"));
         assert_eq!(a.best.trace.controls, b.best.trace.controls);
         assert_eq!(a.evaluations, b.evaluations);
         assert!(a.best.valid() && !a.timed_out);
@@ -676,9 +674,12 @@ mod tests {
         let scene = abh_scene();
         let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
         let settings = SearchSettings::for_quality(Quality::Fast);
-        let p =
-            plan_jumps(&sim, &settings, Budget::new(Some(std::time::Instant::now()), None))
-                .unwrap_or_else(|| panic!("a plan"));
+        let p = plan_jumps(
+            &sim,
+            &settings,
+            Budget::new(Some(std::time::Instant::now()), None),
+        )
+        .unwrap_or_else(|| panic!("a plan"));
         assert!(p.timed_out && p.best.valid());
         let hand = run_abh(&sim, AbhParams::default());
         assert_eq!(p.best.trace.crossing, hand.trace.crossing);

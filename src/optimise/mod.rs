@@ -12,5 +12,6 @@ pub mod substep;
 
 pub use bound::{lower_bound, LowerBound};
 pub use search::{
-    solve, solve_with_progress, Outcome, Progress, Quality, SearchSettings, SearchStatus,
+    solve, solve_cancellable, solve_with_progress, Outcome, Progress, Quality, SearchSettings,
+    SearchStatus,
 };

@@ -27,7 +27,7 @@ use super::model::{
     FrameLaw, ModelState,
 };
 use super::qp::{self, SubProblem, SubStepStatus, WallRow};
-use super::{lower_bound, LowerBound};
+use super::{bound::lower_bound_within, LowerBound};
 use crate::budget::{Budget, Stage, Stop};
 use crate::error::{Error, Result};
 use crate::geometry::{Corridor, Separation, HULL_HALF_WIDTH_UNITS};
@@ -822,7 +822,12 @@ pub fn solve_with_progress(
     settings: &SearchSettings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome> {
-    solve_within(scene, settings, progress, Budget::from_limit(settings.time_limit, None))
+    solve_within(
+        scene,
+        settings,
+        progress,
+        Budget::from_limit(settings.time_limit, None),
+    )
 }
 
 /// [`solve_with_progress`] that also stops when `cancel` is set: a set flag acts like the time limit
@@ -904,7 +909,7 @@ fn solve_once(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome> {
     let started = Instant::now();
-    let bound = lower_bound(scene, &scene.corridor()?)?;
+    let bound = lower_bound_within(scene, &scene.corridor()?, &budget)?;
     if bound.crossing.frames > settings.max_frames {
         return Err(Error::FrameLimit {
             scene: scene.origin.clone(),
@@ -964,14 +969,9 @@ fn solve_once(
                   status: SearchStatus,
                   stats: SearchStats,
                   source: &'static str| {
-        let engine_exact = sim.run_engine_exact_within(&controls, &budget);
-        // A replay cut short leaves the plan unverified in the engine-exact mode: the status says so.
-        let status = match status {
-            s if engine_exact.interrupted && s.stopped_in().is_none() => {
-                SearchStatus::stopped(&budget, Stage::Verification)
-            }
-            s => s,
-        };
+        // The kept plan's own replay is finished whatever the budget: it is one run of at most
+        // `max_frames` frames, and the result must say whether the plan holds in the engine.
+        let engine_exact = sim.run_engine_exact(&controls);
         Outcome {
             controls,
             trace,
@@ -1016,7 +1016,13 @@ fn solve_once(
         }
         if let Some(stage) = cut_in {
             let status = SearchStatus::stopped(&budget, stage);
-            return Ok(finish(greedy_plan.0, greedy_plan.1, status, stats, "greedy"));
+            return Ok(finish(
+                greedy_plan.0,
+                greedy_plan.1,
+                status,
+                stats,
+                "greedy",
+            ));
         }
         return Ok(finish(
             greedy_plan.0,
@@ -1439,9 +1445,9 @@ fn centred_greedy(
                 };
                 // The verdicts from a run without its frames; only a new best is replayed whole.
                 let run = sim.run_summary(&mut make(), budget);
-                let better = best.as_ref().is_none_or(|b| {
-                    run.crossing.map_or(f64::INFINITY, |c| c.time) < time_of(b)
-                });
+                let better = best
+                    .as_ref()
+                    .is_none_or(|b| run.crossing.map_or(f64::INFINITY, |c| c.time) < time_of(b));
                 if run.feasible() && run.collisions == 0 && better {
                     let t = sim.run(&mut make());
                     if clean(&t) {

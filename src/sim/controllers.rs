@@ -296,9 +296,5 @@ pub fn best_capped_greedy_within(
     } else {
         Budget::unlimited()
     };
-    (
-        sim.run_within(&mut make(la, cap), &replay_budget),
-        la,
-        cap,
-    )
+    (sim.run_within(&mut make(la, cap), &replay_budget), la, cap)
 }
