@@ -91,7 +91,7 @@ pub fn run(args: &SolveArgs) -> Result<String> {
         let mut summary = summary;
         summary["status"] = json!(outcome.status);
         summary["not_written"] = json!(skipped);
-        Ok(format!("{summary}\n"))
+        json_with_plans(&summary, &outcome)
     } else {
         Ok(summary_text(&scene, &outcome))
     }
@@ -118,7 +118,7 @@ fn quality_name(q: Quality) -> &'static str {
     }
 }
 
-/// The `--json` object of a solve.
+/// The `--json` object of a solve without its plans (see [`json_with_plans`]); the HTML report's table.
 pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
     let crossing = o.trace.crossing;
     let lb = o.bound.crossing;
@@ -154,12 +154,43 @@ pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
         "status": o.status,
         "stats": o.stats,
         "solve_seconds": o.solve_seconds,
-        // What `strafeopt report` replays to rebuild both runs.
-        "plans": [
-            {"label": "greedy", "controls": o.greedy.controls},
-            {"label": "optimised", "controls": o.controls},
-        ],
     })
+}
+
+/// A plan in the `--json` object.
+#[derive(serde::Serialize)]
+struct PlanJson<'a> {
+    label: &'a str,
+    controls: &'a [crate::physics::Control],
+}
+
+/// The `--json` object of a solve as text: `summary` ([`summary_json`]) and `plans`, what `strafeopt
+/// report` replays to rebuild both runs. The plans are written straight from the controls: as a JSON
+/// tree they would take some two kilobytes a frame (gigabytes for a run of millions of frames).
+fn json_with_plans(summary: &Value, o: &Outcome) -> Result<String> {
+    #[derive(serde::Serialize)]
+    struct SolveJson<'a> {
+        #[serde(flatten)]
+        summary: &'a Value,
+        plans: [PlanJson<'a>; 2],
+    }
+    let out = SolveJson {
+        summary,
+        plans: [
+            PlanJson {
+                label: "greedy",
+                controls: &o.greedy.controls,
+            },
+            PlanJson {
+                label: "optimised",
+                controls: &o.controls,
+            },
+        ],
+    };
+    let mut text = serde_json::to_string(&out)
+        .map_err(|e| Error::Io(format!("serialising the result: {e}")))?;
+    text.push('\n');
+    Ok(text)
 }
 
 /// A frame rate as typed: whole rates without decimals (`100`), others with two (`66.67`).
