@@ -272,7 +272,9 @@ pub fn best_capped_greedy_within(
             None => g,
         }
     };
-    let mut best: Option<((u8, f64), RunSummary, f64, Option<f64>)> = None;
+    // (rank, run, look-ahead, cap) of the best run so far.
+    type Best = ((u8, f64), RunSummary, f64, Option<f64>);
+    let mut best: Option<Best> = None;
     'sweep: for cap in std::iter::once(None).chain(caps_ups.iter().copied().map(Some)) {
         for &la in lookaheads {
             if best.is_some() && budget.expired() {
