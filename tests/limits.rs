@@ -238,3 +238,81 @@ fn text_output_has_fixed_decimals_in_one_column_and_no_progress_off_a_terminal()
     assert!(text.contains("min clearance:   "), "{text}");
     assert!(text.contains(" units\n"), "{text}");
 }
+
+#[test]
+fn a_run_summary_gives_the_verdicts_of_the_full_run() {
+    use strafeopt::budget::Budget;
+    use strafeopt::sim::{Greedy, Simulation};
+    // The wide bend (runs cross validly), the narrow one (every look-ahead breaks a rule) and the narrow
+    // one between solid walls (runs slide along them: contacts).
+    let solid = shipped("hl-bend90-narrow-100fps").replace("kind = \"rule\"", "kind = \"solid\"");
+    let mut contacts = 0;
+    for (name, text) in [
+        ("hl-bend90-100fps", shipped("hl-bend90-100fps")),
+        (
+            "hl-bend90-narrow-100fps",
+            shipped("hl-bend90-narrow-100fps"),
+        ),
+        ("solid narrow bend", solid),
+    ] {
+        let scene = Scene::from_toml_str(&text, name).unwrap_or_else(|e| panic!("{e}"));
+        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+        let bound = strafeopt::optimise::lower_bound(&scene, sim.corridor())
+            .unwrap_or_else(|e| panic!("{e}"));
+        for la in [25.0, 100.0, 400.0, 1600.0] {
+            let trace = sim.run(&mut Greedy::new(bound.path.clone(), la));
+            let run = sim.run_summary(
+                &mut Greedy::new(bound.path.clone(), la),
+                &Budget::unlimited(),
+            );
+            assert_eq!(run.crossing, trace.crossing, "{name} {la}");
+            assert_eq!(run.feasible(), trace.feasible(), "{name} {la}");
+            assert_eq!(run.collisions, trace.collisions(), "{name} {la}");
+            assert_eq!(run.frames_run, trace.frames.len() as u64, "{name} {la}");
+            assert_eq!(
+                run.broke_rule,
+                trace.first_rule_violation().is_some(),
+                "{name} {la}"
+            );
+            assert!(!run.interrupted && !trace.interrupted);
+            contacts += run.collisions;
+        }
+    }
+    assert!(contacts > 0, "some run touched a solid wall");
+}
+
+#[test]
+fn an_expired_budget_stops_the_greedy_sweep_within_its_first_frames() {
+    use strafeopt::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
+    use strafeopt::sim::controllers::{best_capped_greedy_within, GREEDY_LOOKAHEADS_UNITS};
+    use strafeopt::sim::Simulation;
+    let scene = Scene::from_toml_str(&shipped("hl-bend90-100fps"), "bend")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let bound =
+        strafeopt::optimise::lower_bound(&scene, sim.corridor()).unwrap_or_else(|e| panic!("{e}"));
+    let expired = Budget::new(Some(Instant::now()), None);
+    let (trace, _, _) = best_capped_greedy_within(
+        &sim,
+        &bound.path,
+        &GREEDY_LOOKAHEADS_UNITS,
+        &[500.0, 600.0],
+        &expired,
+    );
+    // One run was started and cut at its first look at the budget; none after it.
+    assert!(trace.interrupted && !trace.feasible());
+    assert!(
+        trace.frames.len() as u64 <= FRAMES_PER_BUDGET_CHECK,
+        "{}",
+        trace.frames.len()
+    );
+    // Unlimited, the same sweep finishes (the 100 fps bend: greedy crosses validly).
+    let (full, _, _) = best_capped_greedy_within(
+        &sim,
+        &bound.path,
+        &GREEDY_LOOKAHEADS_UNITS,
+        &[500.0, 600.0],
+        &Budget::unlimited(),
+    );
+    assert!(full.feasible() && !full.interrupted);
+}
