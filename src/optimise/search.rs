@@ -447,6 +447,10 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let (trust, sigma_trust, c_trust) = (self.trust, self.sigma_trust, self.c_trust_ups);
         let upper_at_kink = state.get_iter() % 2 == 0;
         let duals = self.duals.take();
+        let seconds_left = self
+            .budget
+            .remaining()
+            .map_or(f64::INFINITY, |d| d.as_secs_f64());
         let step = problem.problem("linearise-and-solve", |pr| {
             // Each frame stays on its piece of mu = min(gamma1, L - c) within a step, so the linearisation
             // is exact to first order; a frame on the kink tries the upper piece (mu = L - c) on even
@@ -505,7 +509,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
                 c_range: &c_range,
                 curvature: lin.curvature.as_deref(),
             };
-            Ok(qp::solve(&sub))
+            Ok(qp::solve_within_time(&sub, seconds_left))
         })?;
         self.stats.iterations += 1;
         self.stats.subproblems += 1;
