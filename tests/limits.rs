@@ -86,6 +86,22 @@ fn a_100000_fps_bend_past_the_default_limit_is_refused_without_work() {
 }
 
 #[test]
+fn bench_applies_the_frame_limit_before_measuring() {
+    let out = strafeopt(&[
+        "bench",
+        "scenarios/hl-bend90-100fps.toml",
+        "--quick",
+        "--quiet",
+        "--max-frames",
+        "300",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("398") && err.contains("--max-frames"), "{err}");
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
 fn bad_max_frames_is_bad_input() {
     let out = strafeopt(&[
         "solve",
