@@ -276,7 +276,7 @@ fn radius(engine: &EngineFlags, speed: f64) -> Result<Figures> {
             "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
         }),
         text: format!(
-            "maximum-acceleration airstrafe at {speed} ups, {} fps (theta {:.4} deg, mu {:.4})\n\
+            "maximum-acceleration airstrafe at {speed:.2} ups, {} fps (theta {:.4} deg, mu {:.4})\n\
              radius (source text's relation): {source:.4} units\n\
              radius (circle through 3 simulated positions): {measured:.4} units\n\
              radius (first order tau v'^2/(mu sin theta)): {:.4} units\n\
@@ -455,7 +455,7 @@ fn abh_frame_level(vars: &MovementVars, max_speed: f64, distance: f64) -> Result
         )
         .collect();
     let mut text = format!(
-        "frame-level run (tau = {:.4} s, gravity {}, 64.04-unit rule lane, crouched start at rest):\n\
+        "frame-level run (tau = {:.4} s, gravity {:.2} ups/s, 64.04-unit rule lane, crouched start at rest):\n\
          \x20 hop   jump frame   time from pistol (s)   hop time (s)   speed (ups)\n",
         vars.frame_time_s(),
         vars.gravity
