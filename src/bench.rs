@@ -153,6 +153,9 @@ pub struct BenchSettings {
     pub seed: u64,
     /// Time limit of each solve. Default none.
     pub time_limit: Option<Duration>,
+    /// Most frames planned (see [`SearchSettings::max_frames`]): a scene whose lower bound needs more is
+    /// refused before anything is measured, and no run goes further.
+    pub max_frames: u64,
 }
 
 impl Default for BenchSettings {
@@ -162,6 +165,7 @@ impl Default for BenchSettings {
             hill_climb: true,
             seed: HillClimbSettings::default().seed,
             time_limit: None,
+            max_frames: crate::budget::DEFAULT_MAX_PLANNED_FRAMES,
         }
     }
 }
@@ -199,8 +203,19 @@ pub fn measure_scene(
 ) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::new();
     let t = Instant::now();
+    let bound = lower_bound(scene, &scene.corridor()?)?;
+    if bound.crossing.frames > settings.max_frames {
+        return Err(Error::FrameLimit {
+            scene: scene.origin.clone(),
+            frames: bound.crossing.frames,
+            limit: settings.max_frames,
+        });
+    }
+    let scene = &Scene {
+        max_frames: scene.max_frames.min(settings.max_frames),
+        ..scene.clone()
+    };
     let sim = Simulation::new(scene)?;
-    let bound = lower_bound(scene, sim.corridor())?;
     let corner = bend_width_units.and_then(|w| corner_speed_ups(scene, w));
     let bt = bound.crossing.time;
     let mut row = BenchRow::new(Section::Accuracy, scene, Method::LowerBound, 0, bt)
@@ -237,6 +252,7 @@ pub fn measure_scene(
     for &q in &settings.levels {
         let mut ss = SearchSettings::for_quality(q);
         ss.time_limit = settings.time_limit;
+        ss.max_frames = settings.max_frames;
         let t = Instant::now();
         let out = solve(scene, &ss)?;
         let wall = t.elapsed().as_secs_f64();
@@ -332,6 +348,7 @@ pub fn measure_scaling(
     for s in [scene, &other] {
         let mut ss = SearchSettings::for_quality(quality);
         ss.time_limit = settings.time_limit;
+        ss.max_frames = settings.max_frames;
         let t = Instant::now();
         let out = solve(s, &ss)?;
         let wall = t.elapsed().as_secs_f64();

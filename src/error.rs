@@ -44,6 +44,49 @@ pub enum Error {
     /// A numerical failure the library could not recover from (a NaN at a stage boundary).
     #[error("numerical error: {0}")]
     Numerical(String),
+    /// A scene whose fastest possible run (its lower bound) needs more frames than may be planned.
+    #[error(
+        "{scene}: the fastest possible run takes at least {frames} frames (the lower bound), more than the \
+         {limit} frames that may be planned; raise --max-frames to at least {frames} (memory grows with the \
+         frames)"
+    )]
+    FrameLimit {
+        /// The scene's origin.
+        scene: String,
+        /// The lower bound's frame count.
+        frames: u64,
+        /// The frame limit in force.
+        limit: u64,
+    },
+    /// The time limit or the cancel flag stopped the work before any valid result was found.
+    #[error(
+        "stopped by {reason} in the {stage} stage before any run reached the finish validly{hint}"
+    )]
+    Stopped {
+        /// What stopped it.
+        reason: crate::budget::Stop,
+        /// The stage that was cut.
+        stage: crate::budget::Stage,
+        /// What to do about it, with its leading separator (empty when cancelled).
+        hint: String,
+    },
+}
+
+impl Error {
+    /// The error of a budget that ran out (`reason`, the time limit if `None`) in `stage` with nothing
+    /// valid found.
+    pub fn stopped(reason: Option<crate::budget::Stop>, stage: crate::budget::Stage) -> Self {
+        let reason = reason.unwrap_or(crate::budget::Stop::TimeLimit);
+        let hint = match reason {
+            crate::budget::Stop::TimeLimit => "; raise --time-limit".to_string(),
+            crate::budget::Stop::Cancelled => String::new(),
+        };
+        Error::Stopped {
+            reason,
+            stage,
+            hint,
+        }
+    }
 }
 
 /// Result with the library's error.

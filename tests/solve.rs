@@ -158,12 +158,23 @@ fn a_tiny_time_limit_ends_with_a_valid_plan_and_says_so() {
     let scene = load("hl-bend90-100fps");
     let mut s = SearchSettings::for_quality(Quality::Balanced);
     s.time_limit = Some(Duration::from_millis(10));
-    let o = solve(&scene, &s).unwrap_or_else(|e| panic!("{e}"));
+    // The limit reaches the greedy sweep too: it may end before any run is valid, and then says so.
+    let o = match solve(&scene, &s) {
+        Err(e @ strafeopt::Error::Stopped { .. }) => {
+            assert!(e.to_string().contains("time limit"), "{e}");
+            return;
+        }
+        other => other.unwrap_or_else(|e| panic!("{e}")),
+    };
     assert!(
         o.trace.feasible(),
         "the best valid plan (at worst greedy) is returned"
     );
-    assert_eq!(o.status, SearchStatus::TimeLimit);
+    assert!(
+        matches!(o.status, SearchStatus::TimeLimit { .. }),
+        "{:?}",
+        o.status
+    );
     let t = o.trace.crossing.map_or(f64::INFINITY, |c| c.time);
     let g = o.greedy.crossing.map_or(0.0, |c| c.time);
     assert!(t <= g + 1e-3, "{t} vs greedy {g}");

@@ -443,7 +443,8 @@ fn controller_name(c: ExpectController) -> &'static str {
 pub fn status_name(status: &SearchStatus) -> &'static str {
     match status {
         SearchStatus::Converged { .. } => "converged",
-        SearchStatus::TimeLimit => "time-limit",
+        SearchStatus::TimeLimit { .. } => "time-limit",
+        SearchStatus::Cancelled { .. } => "cancelled",
         SearchStatus::GreedyOnly { .. } => "greedy-only",
         SearchStatus::NoImprovement { .. } => "no-improvement",
     }

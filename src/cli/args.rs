@@ -82,9 +82,13 @@ pub struct SolveArgs {
     /// How hard to work.
     #[arg(long, value_enum, default_value_t = QualityArg::Balanced)]
     pub quality: QualityArg,
-    /// Stop after this many seconds with the best valid plan so far.
+    /// Stop after this many seconds (every stage, writing included) with the best valid plan so far.
     #[arg(long, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
+    /// Most frames to plan: a scene whose fastest possible run needs more is refused at once, and no run
+    /// is simulated further (default 100000, about 1.2 GB at the peak; see docs/limits.md).
+    #[arg(long)]
+    pub max_frames: Option<u64>,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub artifacts: ArtifactFlags,
@@ -274,4 +278,7 @@ pub struct OutputFlags {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Print no progress on stderr.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
 }

@@ -3,7 +3,7 @@
 //! an aligned table or (`--json`) one array of rows; `--svg` writes gap against wall time.
 
 use super::args::QualityArg;
-use super::write_atomically;
+use super::{progress, write_atomically};
 use crate::bench::{
     measure_scaling, measure_scene, quality_name, write_accuracy_svg, BenchRow, BenchSettings,
     Section,
@@ -52,9 +52,15 @@ pub struct BenchArgs {
     /// Write gap against wall time as an SVG figure.
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Most frames a solve plans (see `solve --max-frames`; default 100000).
+    #[arg(long)]
+    pub max_frames: Option<u64>,
     /// Print one JSON array of rows instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Print no progress on stderr.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
 }
 
 fn quality(q: QualityArg) -> Quality {
@@ -98,6 +104,9 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     if let Some(s) = args.time_limit {
         settings.time_limit = Some(time_limit(s)?);
     }
+    if let Some(n) = args.max_frames {
+        settings.max_frames = super::solve::max_frames(n)?;
+    }
     if !(args.scaling_fps.is_finite() && args.scaling_fps > 0.0) {
         return Err(Error::invalid(
             "--scaling-fps",
@@ -120,17 +129,31 @@ pub fn run(args: &BenchArgs) -> Result<String> {
         .map(|p| Scene::load(p).map(|s| (s, bend_width(p))))
         .collect::<Result<_>>()?;
     let mut rows = Vec::new();
-    for (scene, width) in &scenes {
+    let bar = progress::spinner(progress::wanted(args.json, args.quiet));
+    bar.set_prefix("bench");
+    for (i, (scene, width)) in scenes.iter().enumerate() {
+        bar.set_message(format!(
+            "scene {} of {}: {} (every level)",
+            i + 1,
+            scenes.len(),
+            scene.name
+        ));
         rows.extend(measure_scene(scene, *width, &settings)?);
     }
     if !(args.quick || args.no_scaling) {
         if let Some((scene, _)) = scenes.first() {
             if scene.vars.fps != args.scaling_fps {
+                bar.set_message(format!(
+                    "frame-rate scaling: {} at {} fps",
+                    scene.name,
+                    super::solve::fps_text(args.scaling_fps)
+                ));
                 let q = settings.levels.first().copied().unwrap_or(Quality::Fast);
                 rows.extend(measure_scaling(scene, args.scaling_fps, q, &settings)?);
             }
         }
     }
+    bar.finish_and_clear();
     if let Some(path) = &args.svg {
         write_atomically(path, |w| write_accuracy_svg(&rows, w))?;
     }
@@ -164,7 +187,7 @@ pub fn table(rows: &[BenchRow]) -> String {
         }
         cells.push([
             r.scene.clone(),
-            format!("{}", r.fps),
+            super::solve::fps_text(r.fps),
             r.method.name().to_string(),
             opt(r.quality, |q| quality_name(q).to_string()),
             format!("{:.3}", r.wall_seconds),

@@ -217,9 +217,9 @@ fn frames_to_speed(engine: &EngineFlags, from: f64, to: f64, ground: bool) -> Re
             "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
         }),
         text: format!(
-            "{kind} {from} -> {to} ups at {} fps\nframes:             {frames} (by {method})\n\
+            "{kind} {from:.2} -> {to:.2} ups at {} fps\nframes:             {frames} (by {method})\n\
              frames closed form: {closed_text}\ntime:               {:.4} s\n",
-            vars.fps,
+            super::solve::fps_text(vars.fps),
             frames as f64 * tau
         ),
     })
@@ -251,7 +251,7 @@ fn max_ground_speed(engine: &EngineFlags, edge: bool) -> Result<Figures> {
         text: format!(
             "maximum groundstrafe speed at {} fps{}\nspeed (closed form): {speed:.4} ups\n\
              speed (simulated):   {simulated:.4} ups after {frames} frames\n",
-            vars.fps,
+            super::solve::fps_text(vars.fps),
             if edge { ", edge friction" } else { "" }
         ),
     })
@@ -276,12 +276,12 @@ fn radius(engine: &EngineFlags, speed: f64) -> Result<Figures> {
             "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
         }),
         text: format!(
-            "maximum-acceleration airstrafe at {speed} ups, {} fps (theta {:.4} deg, mu {:.4})\n\
+            "maximum-acceleration airstrafe at {speed:.2} ups, {} fps (theta {:.4} deg, mu {:.4})\n\
              radius (source text's relation): {source:.4} units\n\
              radius (circle through 3 simulated positions): {measured:.4} units\n\
              radius (first order tau v'^2/(mu sin theta)): {:.4} units\n\
              the relation gives {:.3} times the measured radius (docs/physics.md section 9)\n",
-            vars.fps,
+            super::solve::fps_text(vars.fps),
             r.theta_rad.to_degrees(),
             r.mu,
             r.first_order,
@@ -305,9 +305,9 @@ fn speed_for(engine: &EngineFlags, radius: f64) -> Result<Figures> {
             "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
         }),
         text: format!(
-            "speed whose maximum-acceleration turn has radius {radius} units at {} fps\n\
+            "speed whose maximum-acceleration turn has radius {radius:.2} units at {} fps\n\
              speed (measured relation): {measured:.4} ups\nspeed (source text's relation): {}\n",
-            vars.fps,
+            super::solve::fps_text(vars.fps),
             source.map_or("none".to_string(), |s| format!("{s:.4} ups"))
         ),
     })
@@ -344,10 +344,10 @@ fn bend(engine: &EngineFlags, width: f64) -> Result<Figures> {
             "inputs": inputs(&vars, preset_name(engine, Preset::GoldSrc)),
         }),
         text: format!(
-            "90-degree bend of width {width} units ({d} for the hull centre) at {} fps\n\
+            "90-degree bend of width {width:.2} units ({d:.2} for the hull centre) at {} fps\n\
              largest arc radius (2 + sqrt 2) d: {r:.4} units\n\
              speed on it (measured relation): {speed:.4} ups\nspeed (source text's relation): {}\n",
-            vars.fps,
+            super::solve::fps_text(vars.fps),
             source.map_or("none".to_string(), |s| format!("{s:.4} ups"))
         ),
     })
@@ -366,8 +366,8 @@ fn abh_table(
     let a = abh::article_model(max_speed, hop_time, distance, vars.maxvelocity);
     let crossing = finite("crossing_time", a.crossing_time)?;
     let mut text = format!(
-        "accelerated backhopping, the article's model: Mx = {max_speed}, hop time {hop_time} s, \
-         sv_maxvelocity {}\n  hop     time (s)   distance (units)   speed (ups)\n",
+        "accelerated backhopping, the article's model: Mx = {max_speed:.2} ups, hop time {hop_time:.3} s, \
+         sv_maxvelocity {:.2} ups\n  hop     time (s)   distance (units)   speed (ups)\n",
         vars.maxvelocity
     );
     for (i, h) in a.hops.iter().enumerate() {
@@ -380,7 +380,7 @@ fn abh_table(
         ));
     }
     text.push_str(&format!(
-        "line at {distance} units crossed {crossing:.3} s after the first jump; the hop lands {:.2} units past it\n",
+        "line at {distance:.2} units crossed {crossing:.3} s after the first jump; the hop lands {:.2} units past it\n",
         a.landing_past_line
     ));
     let frame_level = abh_frame_level(&vars, max_speed, distance)?;
@@ -455,7 +455,7 @@ fn abh_frame_level(vars: &MovementVars, max_speed: f64, distance: f64) -> Result
         )
         .collect();
     let mut text = format!(
-        "frame-level run (tau = {:.4} s, gravity {}, 64.04-unit rule lane, crouched start at rest):\n\
+        "frame-level run (tau = {:.4} s, gravity {:.2} ups/s, 64.04-unit rule lane, crouched start at rest):\n\
          \x20 hop   jump frame   time from pistol (s)   hop time (s)   speed (ups)\n",
         vars.frame_time_s(),
         vars.gravity

@@ -7,6 +7,7 @@ pub mod args;
 pub mod bench;
 pub mod calc;
 pub mod check;
+pub mod progress;
 pub mod report_cmd;
 pub mod simulate;
 pub mod solve;
@@ -28,9 +29,10 @@ pub const EXIT_NO_PATH: u8 = 3;
 /// The exit code for a library error.
 pub fn exit_code(e: &Error) -> u8 {
     match e {
-        Error::InvalidValue { .. } | Error::Scene { .. } | Error::Unreachable { .. } => {
-            EXIT_BAD_INPUT
-        }
+        Error::InvalidValue { .. }
+        | Error::Scene { .. }
+        | Error::Unreachable { .. }
+        | Error::FrameLimit { .. } => EXIT_BAD_INPUT,
         Error::NoValidPath(_) => EXIT_NO_PATH,
         _ => EXIT_FAILURE,
     }
@@ -175,8 +177,43 @@ pub fn write_artifacts(
     bound: &crate::optimise::LowerBound,
     summary: &serde_json::Value,
 ) -> Result<(), Error> {
+    write_artifacts_within(
+        artifacts,
+        scene,
+        plan,
+        runs,
+        bound,
+        summary,
+        &crate::budget::Budget::unlimited(),
+    )
+    .map(|_| ())
+}
+
+/// [`write_artifacts`] within `budget`: a file whose turn comes after the budget has run out is not
+/// written (a file is written whole or not at all). Returns the flags of the files not written.
+pub fn write_artifacts_within(
+    artifacts: &args::ArtifactFlags,
+    scene: &crate::scene::Scene,
+    plan: &crate::sim::Trace,
+    runs: &[(&str, &crate::sim::Trace)],
+    bound: &crate::optimise::LowerBound,
+    summary: &serde_json::Value,
+    budget: &crate::budget::Budget,
+) -> Result<Vec<&'static str>, Error> {
     use crate::report;
-    if let Some(path) = &artifacts.trajectory {
+    let mut skipped = Vec::new();
+    let mut turn = |flag: &'static str, asked: bool| {
+        let go = asked && !budget.expired();
+        if asked && !go {
+            skipped.push(flag);
+        }
+        go
+    };
+    let trajectory = artifacts
+        .trajectory
+        .as_ref()
+        .filter(|_| turn("--trajectory", true));
+    if let Some(path) = trajectory {
         let json = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
@@ -188,14 +225,16 @@ pub fn write_artifacts(
             }
         })?;
     }
-    if let Some(path) = &artifacts.report {
+    let html = artifacts.report.as_ref().filter(|_| turn("--report", true));
+    if let Some(path) = html {
         let input = runs.iter().fold(
             report::ReportInput::new(scene, bound, summary),
             |input, (label, trace)| input.with_run(label, trace),
         );
         write_atomically(path, |w| report::write_html(&input, w))?;
     }
-    if let Some(path) = &artifacts.hltas {
+    let hltas = artifacts.hltas.as_ref().filter(|_| turn("--hltas", true));
+    if let Some(path) = hltas {
         let script = report::hltas_script(plan, &scene.vars, &scene.name)?;
         write_atomically(path, |w| {
             script
@@ -203,5 +242,5 @@ pub fn write_artifacts(
                 .map_err(|e| std::io::Error::other(format!("{e:?}")))
         })?;
     }
-    Ok(())
+    Ok(skipped)
 }

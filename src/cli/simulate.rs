@@ -130,7 +130,7 @@ fn summary_text(
         "{} ({} at {} fps, effects: {})\ncontroller:     {}{}\n",
         scene.name,
         scene.preset.name(),
-        scene.vars.fps,
+        super::solve::fps_text(scene.vars.fps),
         scene.effects,
         trace.controller,
         lookahead.map_or(String::new(), |l| format!(" (look-ahead {l:.1} units)"))

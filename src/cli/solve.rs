@@ -1,14 +1,16 @@
 //! `strafeopt solve`: the minimal-time plan of a scene, beside the greedy baseline and the lower bound.
 
 use super::args::{QualityArg, SolveArgs};
-use super::write_artifacts;
+use super::{progress, write_artifacts_within};
+use crate::budget::{Budget, Stage};
 use crate::error::{Error, Result};
 use crate::optimise::search::{self, time_limit};
-use crate::optimise::{Outcome, Quality, SearchSettings};
+use crate::optimise::{Outcome, Quality, SearchSettings, SearchStatus};
 use crate::scene::Scene;
 use serde_json::{json, Value};
 
 /// Runs `solve` and returns what to print. No valid path: [`Error::NoValidPath`] (exit 3), nothing written.
+/// A scene that needs more frames than `--max-frames`: [`Error::FrameLimit`] (exit 2), before any work.
 pub fn run(args: &SolveArgs) -> Result<String> {
     let quality = match args.quality {
         QualityArg::Fast => Quality::Fast,
@@ -19,43 +21,47 @@ pub fn run(args: &SolveArgs) -> Result<String> {
     if let Some(s) = args.time_limit {
         settings.time_limit = Some(time_limit(s)?);
     }
+    if let Some(n) = args.max_frames {
+        settings.max_frames = max_frames(n)?;
+    }
+    // The whole command's budget: the solve, then writing the files.
+    let budget = Budget::from_limit(settings.time_limit, None);
     let scene = Scene::load(&args.scene)?;
     if let Some(path) = &args.artifacts.hltas {
         super::simulate::require_goldsrc_for_hltas(&scene, path)?;
     }
-    // Progress on stderr for people watching a terminal; none with --json or when stderr is redirected.
-    let show = !args.output.json && std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let started = std::time::Instant::now();
-    let outcome = search::solve_with_progress(&scene, &settings, &mut |p| {
-        if show {
-            let line = match p {
-                search::Progress::Baseline {
-                    greedy_frames,
-                    bound_frames,
-                } => format!(
-                    "greedy {}, lower bound frame {bound_frames}",
-                    greedy_frames.map_or("did not finish".to_string(), |f| format!("frame {f}"))
-                ),
-                search::Progress::FrameCount { frames, reached } => format!(
-                    "trying {frames} frames: {}",
-                    reached.map_or("not reached".to_string(), |r| format!(
-                        "crosses in frame {r}"
-                    ))
-                ),
-                search::Progress::Finishing => {
-                    "rounding sides, polishing, checking in engine-exact mode".into()
-                }
-            };
-            eprint!(
-                "\r\x1b[2K[{:>6.1} s] {line}",
-                started.elapsed().as_secs_f64()
-            );
+    let bar = progress::spinner(progress::wanted(args.output.json, args.output.quiet));
+    bar.set_prefix(Stage::Greedy.name());
+    bar.set_message("lower bound, greedy strafer over look-aheads and speed caps");
+    let mut counts_tried = 0u64;
+    let outcome = search::solve_with_progress(&scene, &settings, &mut |p| match p {
+        search::Progress::Baseline {
+            greedy_frames,
+            bound_frames,
+        } => {
+            bar.set_prefix(Stage::Relaxed.name());
+            bar.set_message(format!(
+                "greedy {}, lower bound frame {bound_frames}",
+                greedy_frames.map_or("did not finish".to_string(), |f| format!("frame {f}"))
+            ));
+        }
+        search::Progress::FrameCount { frames, reached } => {
+            counts_tried += 1;
+            bar.set_prefix(Stage::Relaxed.name());
+            bar.set_message(format!(
+                "frame counts tried {counts_tried}, last {frames}: {}",
+                reached.map_or("not reached".to_string(), |r| format!(
+                    "crosses in frame {r}"
+                ))
+            ));
+        }
+        search::Progress::Finishing => {
+            bar.set_prefix(Stage::Rounding.name());
+            bar.set_message("rounding sides, polishing, checking in engine-exact mode");
         }
     });
-    if show {
-        eprintln!();
-    }
-    let outcome = outcome?;
+    bar.finish_and_clear();
+    let mut outcome = outcome?;
     if !outcome.trace.feasible() {
         return Err(Error::NoValidPath(format!(
             "{}: neither the optimiser nor the greedy strafer found a run that reaches the finish without \
@@ -64,18 +70,43 @@ pub fn run(args: &SolveArgs) -> Result<String> {
         )));
     }
     let summary = summary_json(&scene, quality, &outcome);
-    write_artifacts(
+    let skipped = write_artifacts_within(
         &args.artifacts,
         &scene,
         &outcome.trace,
         &[("greedy", &outcome.greedy), ("optimised", &outcome.trace)],
         &outcome.bound,
         &summary,
+        &budget,
     )?;
+    if !skipped.is_empty() {
+        for flag in &skipped {
+            eprintln!("strafeopt: {flag} not written: the time limit ran out before it");
+        }
+        if outcome.status.stopped_in().is_none() {
+            outcome.status = SearchStatus::stopped(&budget, Stage::Writing);
+        }
+    }
     if args.output.json {
-        Ok(format!("{summary}\n"))
+        let mut summary = summary;
+        summary["status"] = json!(outcome.status);
+        summary["not_written"] = json!(skipped);
+        json_with_plans(&summary, &outcome)
     } else {
         Ok(summary_text(&scene, &outcome))
+    }
+}
+
+/// Checks `--max-frames`.
+pub fn max_frames(n: u64) -> Result<u64> {
+    if n >= 1 {
+        Ok(n)
+    } else {
+        Err(Error::invalid(
+            "--max-frames",
+            n as f64,
+            "a whole number of frames of at least 1",
+        ))
     }
 }
 
@@ -87,7 +118,7 @@ fn quality_name(q: Quality) -> &'static str {
     }
 }
 
-/// The `--json` object of a solve.
+/// The `--json` object of a solve without its plans (see [`json_with_plans`]); the HTML report's table.
 pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
     let crossing = o.trace.crossing;
     let lb = o.bound.crossing;
@@ -130,11 +161,6 @@ pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
         "status": o.status,
         "stats": o.stats,
         "solve_seconds": o.solve_seconds,
-        // What `strafeopt report` replays to rebuild both runs.
-        "plans": [
-            {"label": "greedy", "controls": o.greedy.controls},
-            {"label": "optimised", "controls": o.controls},
-        ],
     })
 }
 
@@ -145,75 +171,152 @@ pub fn rounding_loss_frames(scene: &Scene, o: &Outcome) -> Option<f64> {
     Some((c.time - r.time) / scene.frame_time_s())
 }
 
+/// A plan in the `--json` object.
+#[derive(serde::Serialize)]
+struct PlanJson<'a> {
+    label: &'a str,
+    controls: &'a [crate::physics::Control],
+}
+
+/// The `--json` object of a solve as text: `summary` ([`summary_json`]) and `plans`, what `strafeopt
+/// report` replays to rebuild both runs. The plans are written straight from the controls: as a JSON
+/// tree they would take some two kilobytes a frame (gigabytes for a run of millions of frames).
+fn json_with_plans(summary: &Value, o: &Outcome) -> Result<String> {
+    #[derive(serde::Serialize)]
+    struct SolveJson<'a> {
+        #[serde(flatten)]
+        summary: &'a Value,
+        plans: [PlanJson<'a>; 2],
+    }
+    let out = SolveJson {
+        summary,
+        plans: [
+            PlanJson {
+                label: "greedy",
+                controls: &o.greedy.controls,
+            },
+            PlanJson {
+                label: "optimised",
+                controls: &o.controls,
+            },
+        ],
+    };
+    let mut text = serde_json::to_string(&out)
+        .map_err(|e| Error::Io(format!("serialising the result: {e}")))?;
+    text.push('\n');
+    Ok(text)
+}
+
+/// A frame rate as typed: whole rates without decimals (`100`), others with two (`66.67`).
+pub fn fps_text(fps: f64) -> String {
+    if fps.fract() == 0.0 && fps.abs() < 1e15 {
+        format!("{fps:.0}")
+    } else {
+        format!("{fps:.2}")
+    }
+}
+
+/// One `label: value` line with the labels in one column.
+pub fn field(label: &str, value: impl std::fmt::Display) -> String {
+    format!("{:<16} {value}\n", format!("{label}:"))
+}
+
 fn summary_text(scene: &Scene, o: &Outcome) -> String {
     let fmt_time = |c: Option<crate::sim::Crossing>| {
         c.map_or("not reached".to_string(), |c| {
             format!(
-                "{:.6} s (frame {}, {:.4} through it)",
+                "{:>10.6} s (frame {}, {:.4} through it)",
                 c.time, c.frames, c.fraction
             )
         })
     };
     let lb = o.bound.crossing;
     let mut s = format!(
-        "{} ({} at {} fps)\nplan ({}):      {}\n",
+        "{} ({} at {} fps)\n",
         scene.name,
         scene.preset.name(),
-        scene.vars.fps,
-        o.source,
-        fmt_time(o.trace.crossing)
+        fps_text(scene.vars.fps)
     );
-    s.push_str(&format!(
-        "engine-exact:    {}{}\n",
-        fmt_time(o.engine_exact.crossing),
-        if o.engine_exact.feasible() {
-            ", valid"
-        } else {
-            ", INVALID"
-        }
+    s.push_str(&field(
+        "plan",
+        format!("{} ({})", fmt_time(o.trace.crossing), o.source),
     ));
-    s.push_str(&format!(
-        "greedy:          {}{}\n",
-        fmt_time(o.greedy.crossing),
-        if o.greedy.feasible() {
-            ", valid"
-        } else {
-            ", breaks a rule"
-        }
+    s.push_str(&field(
+        "engine-exact",
+        format!(
+            "{}, {}",
+            fmt_time(o.engine_exact.crossing),
+            match (o.engine_exact.feasible(), o.engine_exact.interrupted) {
+                (true, _) => "valid",
+                (false, true) => "not checked (stopped)",
+                (false, false) => "INVALID",
+            }
+        ),
     ));
-    s.push_str(&format!("greedy guide:    {}\n", o.greedy_guide));
-    s.push_str(&format!(
-        "lower bound:     {:.6} s (frame {})\n",
-        lb.time, lb.frames
+    s.push_str(&field(
+        "greedy",
+        format!(
+            "{}, {}",
+            fmt_time(o.greedy.crossing),
+            if o.greedy.feasible() {
+                "valid"
+            } else {
+                "breaks a rule"
+            }
+        ),
+    ));
+    s.push_str(&field("greedy guide", o.greedy_guide));
+    s.push_str(&field(
+        "lower bound",
+        format!("{:>10.6} s (frame {})", lb.time, lb.frames),
     ));
     if let Some(r) = o.relaxed {
-        s.push_str(&format!(
-            "relaxed optimum: {:.6} s (frame {}; a local optimum: {} of {} starts reached the line, spread {:.6} s)\n",
-            r.time, r.frames, r.reached, r.starts, r.spread
+        s.push_str(&field(
+            "relaxed optimum",
+            format!(
+                "{:>10.6} s (frame {}; a local optimum: {} of {} starts reached the line, spread {:.6} s)",
+                r.time, r.frames, r.reached, r.starts, r.spread
+            ),
         ));
     }
     if let Some(loss) = rounding_loss_frames(scene, o) {
-        s.push_str(&format!("rounding loss:   {loss:.3} frames\n"));
+        s.push_str(&field("rounding loss", format!("{loss:>10.3} frames")));
     }
     if let Some(c) = o.trace.crossing {
-        s.push_str(&format!(
-            "gap to bound:    {:.3}%\n",
-            100.0 * (c.time - lb.time) / lb.time.max(f64::MIN_POSITIVE)
+        s.push_str(&field(
+            "gap to bound",
+            format!(
+                "{:>10.3} %",
+                100.0 * (c.time - lb.time) / lb.time.max(f64::MIN_POSITIVE)
+            ),
         ));
         if let Some(g) = o.greedy.crossing.filter(|_| o.greedy.feasible()) {
-            s.push_str(&format!(
-                "gain on greedy:  {:.6} s ({} frames)\n",
-                g.time - c.time,
-                g.frames as i64 - c.frames as i64
+            s.push_str(&field(
+                "gain on greedy",
+                format!(
+                    "{:>10.6} s ({} frames)",
+                    g.time - c.time,
+                    g.frames as i64 - c.frames as i64
+                ),
             ));
         }
     }
-    s.push_str(&format!(
-        "min clearance:   {:.3e} units\nstatus:          {}\nsolve time:      {:.2} s ({} iterations)\n",
-        o.trace.min_clearance(),
-        o.status,
-        o.solve_seconds,
-        o.stats.iterations
+    let clearance = o.trace.min_clearance();
+    s.push_str(&field(
+        "min clearance",
+        if clearance.is_finite() {
+            format!("{clearance:>10.6} units")
+        } else {
+            "no walls".to_string()
+        },
+    ));
+    s.push_str(&field("status", &o.status));
+    s.push_str(&field(
+        "solve time",
+        format!(
+            "{:>10.2} s ({} iterations)",
+            o.solve_seconds, o.stats.iterations
+        ),
     ));
     s
 }

@@ -8,8 +8,8 @@
 //! the same with speed caps from the radius-speed relation (section 9). The fastest valid run is the
 //! baseline, and which guide gave it is reported.
 
-use super::verify::time_of;
 use super::LowerBound;
+use crate::budget::Budget;
 use crate::geometry::{Corridor, HULL_HALF_WIDTH_UNITS};
 use crate::physics::curvature::{bend_arc_radius, speed_for_radius};
 use crate::physics::Vec2;
@@ -171,19 +171,33 @@ fn centre_line(scene: &Scene) -> Option<(f64, Vec<Vec2>)> {
 }
 
 /// The baseline and seeds of `scene` (see the module documentation). The planning model has no
-/// collisions (after a contact the model and the game part ways), so the seeds are clean runs.
-pub(super) fn baseline(sim: &Simulation, scene: &Scene, bound: &LowerBound) -> Baseline {
+/// collisions (after a contact the model and the game part ways), so the seeds are clean runs. Each run
+/// is first played for its verdicts only; the few kept are played again whole, so the memory held is a
+/// few runs' whatever the number of guides and look-aheads. Stops sweeping when `budget` runs out.
+pub(super) fn baseline(
+    sim: &Simulation,
+    scene: &Scene,
+    bound: &LowerBound,
+    budget: &Budget,
+) -> Baseline {
     let guides = guide_paths(scene, bound);
     let caps = if scene.effects.is_air_only() {
         corner_caps(scene)
     } else {
         Vec::new()
     };
-    // Per guide path and cap, the fastest valid run and the fastest clean run.
-    let mut valid: Option<GuideRun> = None;
-    let mut fallback: Option<((u8, f64), GuideRun)> = None;
-    let mut clean: Vec<GuideRun> = Vec::new();
-    for cap in std::iter::once(None).chain(caps.iter().copied().map(Some)) {
+    let strafer = |path: &[Vec2], guide: &GreedyGuide| {
+        let g = Greedy::new(path.to_vec(), guide.lookahead_units);
+        match guide.speed_cap_ups {
+            Some(cap) => g.with_speed_cap(cap),
+            None => g,
+        }
+    };
+    // The fastest valid run, else the best-ranked invalid one, and per guide and cap the fastest clean run.
+    let mut valid: Option<(f64, usize, GreedyGuide)> = None;
+    let mut fallback: Option<((u8, f64), usize, GreedyGuide)> = None;
+    let mut clean: Vec<(f64, usize, GreedyGuide)> = Vec::new();
+    'sweep: for cap in std::iter::once(None).chain(caps.iter().copied().map(Some)) {
         // Capped runs along the shortest path and the widest guide only: the caps are for corners the
         // uncapped strafer overshoots, and every guide in between would multiply the runs.
         let last = guides.len() - 1;
@@ -191,75 +205,70 @@ pub(super) fn baseline(sim: &Simulation, scene: &Scene, bound: &LowerBound) -> B
             if cap.is_some() && i != 0 && i != last {
                 continue;
             }
-            let mut best_clean: Option<GuideRun> = None;
+            let mut best_clean: Option<(f64, usize, GreedyGuide)> = None;
             for &la in &GREEDY_LOOKAHEADS_UNITS {
-                let strafer = Greedy::new(g.path.clone(), la);
-                let trace = sim.run(&mut match cap {
-                    Some(cap) => strafer.with_speed_cap(cap),
-                    None => strafer,
-                });
-                let run = GuideRun {
-                    guide: GreedyGuide {
-                        clearance_units: g.clearance_units,
-                        centre_line: g.centre_line,
-                        lookahead_units: la,
-                        speed_cap_ups: cap,
-                    },
-                    trace,
-                };
-                let t = time_of(&run.trace);
-                if is_clean(&run.trace) && best_clean.as_ref().is_none_or(|b| t < time_of(&b.trace))
-                {
-                    best_clean = Some(run.clone());
+                if budget.expired() {
+                    break 'sweep;
                 }
+                let guide = GreedyGuide {
+                    clearance_units: g.clearance_units,
+                    centre_line: g.centre_line,
+                    lookahead_units: la,
+                    speed_cap_ups: cap,
+                };
+                let run = sim.run_summary(&mut strafer(&g.path, &guide), budget);
+                let t = match (run.feasible(), run.crossing) {
+                    (true, Some(c)) => c.time,
+                    _ => f64::INFINITY,
+                };
                 if t.is_finite() {
-                    if valid.as_ref().is_none_or(|b| t < time_of(&b.trace)) {
-                        valid = Some(run);
+                    if run.collisions == 0 && best_clean.as_ref().is_none_or(|b| t < b.0) {
+                        best_clean = Some((t, i, guide));
+                    }
+                    if valid.as_ref().is_none_or(|b| t < b.0) {
+                        valid = Some((t, i, guide));
                     }
                 } else if valid.is_none() {
-                    let r = rank(&run.trace, &g.path);
-                    if fallback.as_ref().is_none_or(|(b, _)| r < *b) {
-                        fallback = Some((r, run));
+                    let r = match run.crossing {
+                        Some(c) => (1, c.time),
+                        None => (2, -Greedy::new(g.path.clone(), 0.0).project(run.end_pos)),
+                    };
+                    if fallback.as_ref().is_none_or(|b| r < b.0) {
+                        fallback = Some((r, i, guide));
                     }
                 }
             }
             clean.extend(best_clean);
         }
     }
-    clean.sort_by(|a, b| time_of(&a.trace).total_cmp(&time_of(&b.trace)));
+    clean.sort_by(|a, b| a.0.total_cmp(&b.0));
     clean.truncate(MAX_STARTS);
+    // The kept runs, played again whole.
+    let replay = |i: usize, guide: GreedyGuide| GuideRun {
+        guide,
+        trace: sim.run(&mut strafer(&guides[i].path, &guide)),
+    };
     let greedy = match (valid, fallback) {
-        (Some(v), _) => v,
-        (None, Some((_, f))) => f,
-        (None, None) => GuideRun {
-            guide: GreedyGuide {
+        (Some((_, i, guide)), _) | (None, Some((_, i, guide))) => replay(i, guide),
+        (None, None) => replay(
+            0,
+            GreedyGuide {
                 clearance_units: 0.0,
                 centre_line: false,
                 lookahead_units: GREEDY_LOOKAHEADS_UNITS[0],
                 speed_cap_ups: None,
             },
-            trace: sim.run(&mut Greedy::new(
-                bound.path.clone(),
-                GREEDY_LOOKAHEADS_UNITS[0],
-            )),
-        },
+        ),
     };
+    let clean = clean
+        .into_iter()
+        .map(|(_, i, guide)| replay(i, guide))
+        .filter(|r| is_clean(&r.trace))
+        .collect();
     Baseline { greedy, clean }
 }
 
 /// A run the planning model can follow: valid, finished, and touching no wall.
 fn is_clean(t: &Trace) -> bool {
     t.feasible() && t.crossing.is_some() && t.collisions() == 0
-}
-
-/// Sort key of an invalid run: crossings first by time, then the rest by how far along the guide path
-/// they ended (further is better).
-fn rank(t: &Trace, path: &[Vec2]) -> (u8, f64) {
-    match t.crossing {
-        Some(c) => (1, c.time),
-        None => {
-            let end = t.frames.last().map_or(t.start.pos, |f| f.pos);
-            (2, -Greedy::new(path.to_vec(), 0.0).project(end))
-        }
-    }
 }

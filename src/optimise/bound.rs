@@ -8,6 +8,7 @@
 //! caps it at `V_max sqrt 2`), that friction never raises it, and that the new speed of maximum acceleration
 //! grows with the old one.
 
+use crate::budget::{Budget, Stage};
 use crate::error::{Error, Result};
 use crate::geometry::{Corridor, FinishPoint, HULL_HALF_WIDTH_UNITS};
 use crate::physics::strafe::max_accel;
@@ -145,23 +146,50 @@ pub fn time_to_cover(
     distance: f64,
     max_frames: u64,
 ) -> Option<Crossing> {
+    time_to_cover_within(
+        vars,
+        effects,
+        start,
+        distance,
+        max_frames,
+        &Budget::unlimited(),
+    )
+    .ok()
+    .flatten()
+}
+
+/// Frames of the speed profile between two looks at the budget.
+const PROFILE_FRAMES_PER_BUDGET_CHECK: u64 = 1 << 16;
+
+/// [`time_to_cover`] within `budget`: [`Error::Stopped`] when it runs out first.
+fn time_to_cover_within(
+    vars: &MovementVars,
+    effects: Effects,
+    start: &PlayerState,
+    distance: f64,
+    max_frames: u64,
+    budget: &Budget,
+) -> Result<Option<Crossing>> {
     let bound = SpeedBound::new(vars, effects);
     let tau = vars.frame_time_s();
     let mut speed = start.speed();
     let mut covered = 0.0;
     if distance <= 0.0 {
-        return Some(Crossing::new(1, 0.0, tau));
+        return Ok(Some(Crossing::new(1, 0.0, tau)));
     }
     for frame in 1..=max_frames {
+        if frame % PROFILE_FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
+            return Err(Error::stopped(budget.stop(), Stage::LowerBound));
+        }
         speed = bound.next(speed);
         let step = speed * tau;
         if covered + step >= distance && step > 0.0 {
             let fraction = ((distance - covered) / step).clamp(0.0, 1.0);
-            return Some(Crossing::new(frame, fraction, tau));
+            return Ok(Some(Crossing::new(frame, fraction, tau)));
         }
         covered += step;
     }
-    None
+    Ok(None)
 }
 
 /// The schedule-aware bound of a scene with gravity, jumps and the Source jump boost (docs/physics.md
@@ -194,6 +222,17 @@ pub fn jump_schedule_time_to_cover(
     scene: &Scene,
     path_length: f64,
     progress: (Vec2, f64),
+) -> Option<Crossing> {
+    jump_schedule_time_to_cover_within(scene, path_length, progress, &Budget::unlimited())
+}
+
+/// [`jump_schedule_time_to_cover`] within `budget`: a search cut short proves nothing about the
+/// schedules it did not reach, so it gives `None` (and [`lower_bound_within`] the looser profile).
+pub fn jump_schedule_time_to_cover_within(
+    scene: &Scene,
+    path_length: f64,
+    progress: (Vec2, f64),
+    budget: &Budget,
 ) -> Option<Crossing> {
     let (vars, fx) = (&scene.vars, scene.effects);
     if !(fx.has(Effect::Gravity) && fx.has(Effect::Jump) && fx.has(Effect::JumpBoost)) {
@@ -275,6 +314,8 @@ pub fn jump_schedule_time_to_cover(
         max_frames: scene.max_frames,
         best: None,
         steps: 0,
+        budget: *budget,
+        stopped: false,
     };
     let mut run = ScheduleRun {
         frames: 0,
@@ -292,7 +333,7 @@ pub fn jump_schedule_time_to_cover(
         }
     }
     search.ground_phase(run, speed);
-    if search.steps > MAX_SCHEDULE_SEARCH_STEPS {
+    if search.steps > MAX_SCHEDULE_SEARCH_STEPS || search.stopped {
         return None;
     }
     search.best
@@ -334,7 +375,7 @@ struct ScheduleRun {
 }
 
 /// The branch-and-bound search of [`jump_schedule_time_to_cover`].
-struct ScheduleSearch {
+struct ScheduleSearch<'c> {
     bound: SpeedBound,
     tau: f64,
     airtime: u64,
@@ -349,12 +390,22 @@ struct ScheduleSearch {
     max_frames: u64,
     best: Option<Crossing>,
     steps: u64,
+    budget: Budget<'c>,
+    /// The budget ran out: the search is abandoned.
+    stopped: bool,
 }
 
-impl ScheduleSearch {
+/// Steps of the schedule search between two looks at its budget.
+const SCHEDULE_STEPS_PER_BUDGET_CHECK: u64 = 1 << 16;
+
+impl ScheduleSearch<'_> {
     /// True when a schedule at `run` can no longer beat the best (or the budget or frame cap is spent).
-    fn pruned(&self, run: &ScheduleRun) -> bool {
-        run.frames >= self.max_frames
+    fn pruned(&mut self, run: &ScheduleRun) -> bool {
+        if self.steps % SCHEDULE_STEPS_PER_BUDGET_CHECK == 0 && self.budget.expired() {
+            self.stopped = true;
+        }
+        self.stopped
+            || run.frames >= self.max_frames
             || self.steps > MAX_SCHEDULE_SEARCH_STEPS
             || self.best.is_some_and(|b| run.frames >= b.frames)
     }
@@ -456,6 +507,16 @@ pub struct LowerBound {
 /// need only come within the box of the line, at most `16 sqrt 2` units short of it, so that much is
 /// taken off the path. Errors with [`Error::NoValidPath`] when no path reaches the finish.
 pub fn lower_bound(scene: &Scene, corridor: &Corridor) -> Result<LowerBound> {
+    lower_bound_within(scene, corridor, &Budget::unlimited())
+}
+
+/// [`lower_bound`] within `budget`: when it runs out during the jump-schedule search, the bound is the
+/// speed profile's (valid, looser); when it runs out during the profile, [`Error::Stopped`].
+pub fn lower_bound_within(
+    scene: &Scene,
+    corridor: &Corridor,
+    budget: &Budget,
+) -> Result<LowerBound> {
     let (length, path) = corridor
         .shortest_path(scene.start.pos, (scene.finish.a, scene.finish.b))
         .ok_or_else(|| {
@@ -484,22 +545,24 @@ pub fn lower_bound(scene: &Scene, corridor: &Corridor) -> Result<LowerBound> {
         FinishPoint::Hull => HULL_HALF_WIDTH_UNITS * (normal.x.abs() + normal.y.abs()),
     };
     let along = ((scene.finish.a - scene.start.pos).dot(normal) - reach).max(0.0);
-    let crossing = jump_schedule_time_to_cover(scene, path_length, (normal, along))
-        .or_else(|| {
-            time_to_cover(
+    let crossing =
+        match jump_schedule_time_to_cover_within(scene, path_length, (normal, along), budget) {
+            Some(c) => Some(c),
+            None => time_to_cover_within(
                 &scene.vars,
                 scene.effects,
                 &scene.start,
                 path_length,
                 scene.max_frames,
-            )
-        })
-        .ok_or_else(|| {
-            Error::NoValidPath(format!(
+                budget,
+            )?,
+        };
+    let crossing = crossing.ok_or_else(|| {
+        Error::NoValidPath(format!(
             "{}: even the greedy speed profile cannot cover {path_length:.3} units in {} frames",
             scene.origin, scene.max_frames
         ))
-        })?;
+    })?;
     Ok(LowerBound {
         path_length,
         path,

@@ -38,6 +38,7 @@
 //! in the engine-exact mode (f32) before it is accepted.
 
 use super::search::{Quality, SearchSettings};
+use crate::budget::Budget;
 use crate::physics::engine_exact::quantise_yaw_rad;
 use crate::physics::strafe::{max_accel_control, strafe_keys};
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2};
@@ -45,7 +46,6 @@ use crate::sim::abh::{boost_addition, jump_airtime_s, lane_centre_line, run_abh,
 use crate::sim::{Controller, EngineRun, Simulation, Trace};
 use serde::Serialize;
 use std::f64::consts::PI;
-use std::time::Instant;
 
 /// Largest speed across the lane the steering asks for, as a share of the speed.
 const MAX_LATERAL_SHARE: f64 = 0.25;
@@ -357,29 +357,31 @@ pub struct JumpPlan {
     pub evaluations: u64,
     /// Coordinate-descent sweeps run.
     pub sweeps: u64,
-    /// The deadline stopped the search.
+    /// The budget (time limit or cancel flag) stopped the search.
     pub timed_out: bool,
 }
 
-/// The search's state: the best candidate, the work done, the deadline.
-struct Search<'a, 's> {
+/// The search's state: the best candidate, the work done, the budget.
+struct Search<'a, 's, 'c> {
     sim: &'a Simulation<'s>,
     best: Option<Candidate>,
     evaluations: u64,
-    deadline: Option<Instant>,
+    budget: Budget<'c>,
     timed_out: bool,
 }
 
-impl Search<'_, '_> {
+impl Search<'_, '_, '_> {
     /// Simulates `policy` (in `f64`, and engine-exact when it would become the best) and keeps it if it
     /// is valid and crosses strictly earlier. Returns whether it was kept.
     fn try_policy(&mut self, policy: JumpPolicy) -> bool {
-        if self.deadline.is_some_and(|d| Instant::now() >= d) {
+        if self.budget.expired() {
             self.timed_out = true;
             return false;
         }
         self.evaluations += 1;
-        let trace = self.sim.run(&mut JumpRunner::new(policy));
+        let trace = self
+            .sim
+            .run_within(&mut JumpRunner::new(policy), &self.budget);
         self.consider(policy, trace)
     }
 
@@ -392,7 +394,14 @@ impl Search<'_, '_> {
         if self.best.as_ref().is_some_and(|b| t >= b.time()) {
             return false;
         }
-        let engine_exact = self.sim.run_engine_exact(&trace.controls);
+        // The first valid run is verified whatever the budget, so there is always a result to return.
+        let budget = if self.best.is_some() {
+            self.budget
+        } else {
+            Budget::unlimited()
+        };
+        let engine_exact = self.sim.run_engine_exact_within(&trace.controls, &budget);
+        self.timed_out |= engine_exact.interrupted;
         let cand = Candidate {
             policy,
             trace,
@@ -435,11 +444,7 @@ fn first_ground_tick(sim: &Simulation) -> u64 {
 /// or `None` when the scene cannot jump with the Source boost (no gravity, jump or boost: nothing here
 /// applies) or no candidate reached the line validly. The hand-tuned ABH controller
 /// ([`crate::sim::abh::Abh`]) is one of the candidates, so the plan is never worse than it.
-pub fn plan_jumps(
-    sim: &Simulation,
-    settings: &SearchSettings,
-    deadline: Option<Instant>,
-) -> Option<JumpPlan> {
+pub fn plan_jumps(sim: &Simulation, settings: &SearchSettings, budget: Budget) -> Option<JumpPlan> {
     let fx = sim.scene().effects;
     if !(fx.has(Effect::Gravity) && fx.has(Effect::Jump) && fx.has(Effect::JumpBoost)) {
         return None;
@@ -448,7 +453,7 @@ pub fn plan_jumps(
         sim,
         best: None,
         evaluations: 0,
-        deadline,
+        budget,
         timed_out: false,
     };
     // The hand-tuned run is the baseline to beat.
@@ -643,8 +648,10 @@ mod tests {
         let scene = abh_scene();
         let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
         let settings = SearchSettings::for_quality(Quality::Fast);
-        let a = plan_jumps(&sim, &settings, None).unwrap_or_else(|| panic!("a plan"));
-        let b = plan_jumps(&sim, &settings, None).unwrap_or_else(|| panic!("a plan"));
+        let a =
+            plan_jumps(&sim, &settings, Budget::unlimited()).unwrap_or_else(|| panic!("a plan"));
+        let b =
+            plan_jumps(&sim, &settings, Budget::unlimited()).unwrap_or_else(|| panic!("a plan"));
         assert_eq!(a.best.trace.controls, b.best.trace.controls);
         assert_eq!(a.evaluations, b.evaluations);
         assert!(a.best.valid() && !a.timed_out);
@@ -667,8 +674,12 @@ mod tests {
         let scene = abh_scene();
         let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
         let settings = SearchSettings::for_quality(Quality::Fast);
-        let p =
-            plan_jumps(&sim, &settings, Some(Instant::now())).unwrap_or_else(|| panic!("a plan"));
+        let p = plan_jumps(
+            &sim,
+            &settings,
+            Budget::new(Some(std::time::Instant::now()), None),
+        )
+        .unwrap_or_else(|| panic!("a plan"));
         assert!(p.timed_out && p.best.valid());
         let hand = run_abh(&sim, AbhParams::default());
         assert_eq!(p.best.trace.crossing, hand.trace.crossing);
@@ -681,6 +692,6 @@ mod tests {
             Scene::from_toml_str(text, "hl-bhop-cap-100fps.toml").unwrap_or_else(|e| panic!("{e}"));
         let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
         let settings = SearchSettings::for_quality(Quality::Fast);
-        assert!(plan_jumps(&sim, &settings, None).is_none());
+        assert!(plan_jumps(&sim, &settings, Budget::unlimited()).is_none());
     }
 }

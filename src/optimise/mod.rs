@@ -21,5 +21,6 @@ pub use baseline::GreedyGuide;
 pub use bound::{lower_bound, LowerBound};
 pub use relaxed::RelaxedCertificate;
 pub use search::{
-    solve, solve_with_progress, Outcome, Progress, Quality, SearchSettings, SearchStatus,
+    solve, solve_cancellable, solve_with_progress, Outcome, Progress, Quality, SearchSettings,
+    SearchStatus,
 };

@@ -5,11 +5,11 @@ use super::model::{frame_control_of, rollout, FrameControl, FrameLaw, ModelState
 use super::scp::{scp_stage, ScpProblem};
 use super::search::{SearchSettings, SearchStats};
 use super::LowerBound;
+use crate::budget::{Budget, Stage};
 use crate::physics::curvature::air_law;
 use crate::physics::{Control, Vec2};
 use crate::scene::Scene;
 use crate::sim::{Crossing, Simulation, Trace};
-use std::time::Instant;
 
 /// Below this start speed, ups, the planning model has no heading to work from: the seed's first frame is
 /// played as it is and the plan starts after it.
@@ -28,9 +28,12 @@ pub(super) struct Planner<'a> {
     pub(super) fl: FrameLaw,
     /// The finish line's normal, pointing the way the shortest path crosses it.
     pub(super) progress_dir: Vec2,
-    pub(super) deadline: Option<Instant>,
+    pub(super) budget: Budget<'a>,
     pub(super) stats: SearchStats,
+    /// Whether the budget stopped a stage.
     pub(super) timed_out: bool,
+    /// The first stage the budget cut.
+    pub(super) cut_in: Option<Stage>,
 }
 
 /// The airborne frame law of a scene.
@@ -51,7 +54,7 @@ impl<'a> Planner<'a> {
         settings: &'a SearchSettings,
         bound: &LowerBound,
         seed: &Trace,
-        deadline: Option<Instant>,
+        budget: Budget<'a>,
     ) -> Self {
         let prefix: Vec<Control> = if scene.start.speed() < MIN_PLANNING_SPEED_UPS {
             seed.controls.iter().take(1).copied().collect()
@@ -79,9 +82,10 @@ impl<'a> Planner<'a> {
             prefix,
             fl: frame_law(scene),
             progress_dir: finish_direction(scene, bound),
-            deadline,
+            budget,
             stats: SearchStats::default(),
             timed_out: false,
+            cut_in: None,
         }
     }
 
@@ -121,7 +125,7 @@ impl<'a> Planner<'a> {
             controls,
             max_iters,
             self.settings,
-            self.deadline,
+            self.budget,
             &mut self.stats,
             &mut self.timed_out,
         )
@@ -143,12 +147,20 @@ impl<'a> Planner<'a> {
         None
     }
 
-    /// Whether the deadline has passed (and notes it).
+    /// Whether the budget has run out (and notes it).
     pub(super) fn out_of_time(&mut self) -> bool {
-        if self.deadline.is_some_and(|d| Instant::now() >= d) {
+        if self.budget.expired() {
             self.timed_out = true;
         }
         self.timed_out
+    }
+
+    /// Notes that `stage` was cut when the budget stopped it (the first such stage is the one reported).
+    pub(super) fn note_cut(&mut self, stage: Stage) {
+        if self.timed_out || self.budget.expired() {
+            self.timed_out = true;
+            self.cut_in = self.cut_in.or(Some(stage));
+        }
     }
 
     /// The `seed` run in planning variables, after the prefix: the warm start of the relaxed stage. Each

@@ -7,6 +7,7 @@ use super::model::{rollout, FrameControl};
 use super::planner::Planner;
 use super::rounding::round_sides;
 use super::scp::{model_crossing, CLEAN_VIOLATION_UNITS};
+use crate::budget::Stage;
 
 /// Times the relaxed plan is re-solved with a wider margin when rounding leaves the walls.
 const MARGIN_RETRIES: usize = 3;
@@ -26,7 +27,11 @@ pub(super) fn rounded_and_polished(
     let mut relaxed = relaxed.to_vec();
     let mut margin = relaxed_margin;
     for attempt in 0..=MARGIN_RETRIES {
-        let mut exact = round_sides(&planner.start, &relaxed, &fl);
+        let Some(mut exact) = round_sides(&planner.start, &relaxed, &fl, &planner.budget) else {
+            planner.timed_out = true;
+            planner.note_cut(Stage::Rounding);
+            break;
+        };
         if planner.settings.polish_iters > 0 && !planner.timed_out {
             let pr = planner.problem(final_margin, false, 1);
             exact = planner.stage(pr, exact, planner.settings.polish_iters).0;
@@ -35,6 +40,7 @@ pub(super) fn rounded_and_polished(
         let clean = planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS;
         let reaches = model_crossing(&planner.start, &st, planner.scene).is_some();
         candidates.push(exact);
+        planner.note_cut(Stage::Rounding);
         if (clean && reaches) || attempt == MARGIN_RETRIES || planner.timed_out {
             break;
         }

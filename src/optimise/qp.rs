@@ -112,8 +112,19 @@ pub fn solve(sp: &SubProblem) -> SubStep {
     solve_capped(sp, MAX_SUBPROBLEM_ITERATIONS)
 }
 
+/// [`solve`] stopped after `time_limit_s` seconds (Clarabel's own clock; infinite: no limit): a
+/// sub-problem cut short is a failed step (`MaxTime`), so the search's deadline holds inside one too.
+pub fn solve_within_time(sp: &SubProblem, time_limit_s: f64) -> SubStep {
+    solve_limited(sp, MAX_SUBPROBLEM_ITERATIONS, time_limit_s)
+}
+
 /// [`solve`] with Clarabel's iteration cap given (tests force its `MaxIterations` status with it).
 pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
+    solve_limited(sp, max_iterations, f64::INFINITY)
+}
+
+/// [`solve`] with Clarabel's iteration cap and time limit, seconds.
+fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> SubStep {
     let n = sp.jacobians.len();
     let m_w = sp.walls.len();
     let nu = 2 * n;
@@ -264,6 +275,7 @@ pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
         .verbose(false)
         .presolve_enable(false)
         .max_iter(max_iterations)
+        .time_limit(time_limit_s)
         // Ruiz equilibration off: on these sub-problems it doubled Clarabel's interior-point iterations
         // (about 40 against 20 on the 100 fps bend) and the solve time, for no better steps.
         .equilibrate_enable(false)

@@ -8,6 +8,7 @@ use super::model::{rollout_knots, FrameControl};
 use super::planner::Planner;
 use super::scp::{model_crossing, ScpProblem};
 use super::search::Progress;
+use crate::budget::Stage;
 use crate::sim::Crossing;
 
 /// Times a relaxed stage that stopped at its iteration cap without a clean crossing is continued at the
@@ -135,6 +136,7 @@ pub(super) fn count_search<'a>(
     let mut continue_tries = 0;
     loop {
         if planner.out_of_time() {
+            planner.note_cut(Stage::Relaxed);
             break;
         }
         controls.resize(
@@ -147,6 +149,7 @@ pub(super) fn count_search<'a>(
         planner.stats.frame_counts_tried += 1;
         let pr = problem(planner);
         let (c, capped) = planner.stage(pr, controls.clone(), relaxed_iters);
+        planner.note_cut(Stage::Relaxed);
         let states = rollout_knots(&planner.start, &c, &fl, frames_per_knot);
         let reached = model_crossing(&planner.start, &states, planner.scene);
         let clean = problem(planner).violation(&states) <= super::scp::CLEAN_VIOLATION_UNITS;

@@ -2,6 +2,7 @@
 //! frame's wish direction is on one side of the velocity or the other).
 
 use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState};
+use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 
 /// How far ahead a heading error is weighed by the side rounding, seconds.
 pub(super) const ROUNDING_HORIZON_S: f64 = 0.05;
@@ -13,17 +14,22 @@ const ROUNDING_BEAM: usize = 64;
 /// its heading error would drift over a short horizon. Rounding frame by frame keeps the heading error
 /// bounded but not zero-mean where the relaxed sides saturate, and a steady heading error of a few
 /// hundredths of a radian drifts the path by tens of units.
+/// `None` when `budget` runs out first.
 pub(super) fn round_sides(
     start: &ModelState,
     controls: &[FrameControl],
     fl: &FrameLaw,
-) -> Vec<FrameControl> {
+    budget: &Budget,
+) -> Option<Vec<FrameControl>> {
     let relaxed = rollout(start, controls, fl);
     let horizon_s = ROUNDING_HORIZON_S;
     // Beam entries: (cost, state, index into the history of choices).
     let mut history: Vec<(usize, f64)> = Vec::with_capacity(controls.len() * ROUNDING_BEAM * 2);
     let mut beam: Vec<(f64, ModelState, usize)> = vec![(0.0, *start, usize::MAX)];
     for (k, u) in controls.iter().enumerate() {
+        if k as u64 % FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
+            return None;
+        }
         let target = relaxed[k];
         let mut next: Vec<(f64, ModelState, usize)> = Vec::with_capacity(beam.len() * 2);
         for &(cost, x, h) in &beam {
@@ -52,9 +58,11 @@ pub(super) fn round_sides(
         h = parent;
     }
     sides.reverse();
-    controls
-        .iter()
-        .zip(sides)
-        .map(|(u, sigma)| FrameControl { sigma, c: u.c })
-        .collect()
+    Some(
+        controls
+            .iter()
+            .zip(sides)
+            .map(|(u, sigma)| FrameControl { sigma, c: u.c })
+            .collect(),
+    )
 }

@@ -15,6 +15,7 @@ use super::lagrangian::{convexify, lagrangian_block, CurvatureBlock};
 use super::model::{knot, knot_hessian, rollout_knots, FrameControl, FrameLaw, ModelState};
 use super::qp::{self, SubProblem, SubStepStatus, WallRow};
 use super::search::{SearchSettings, SearchStats};
+use crate::budget::Budget;
 use crate::geometry::{Corridor, Separation};
 use crate::physics::Vec2;
 use crate::scene::Scene;
@@ -176,7 +177,8 @@ type ScpState = IterState<Vec<f64>, (), (), (), (), f64>;
 
 /// One SCP iteration per argmin iteration: linearise, solve the Clarabel sub-problem, accept the step
 /// only if exact re-simulation confirms enough of the predicted gain.
-pub struct ScpSolver {
+pub struct ScpSolver<'c> {
+    budget: Budget<'c>,
     trust: f64,
     sigma_trust: f64,
     c_trust_ups: f64,
@@ -188,9 +190,10 @@ pub struct ScpSolver {
     duals: Option<Vec<[f64; 4]>>,
 }
 
-impl ScpSolver {
-    fn new(tol: f64) -> Self {
+impl<'c> ScpSolver<'c> {
+    fn new(tol: f64, budget: Budget<'c>) -> Self {
         ScpSolver {
+            budget,
             trust: 1.0,
             sigma_trust: 0.1,
             c_trust_ups: 5.0,
@@ -215,7 +218,7 @@ const MERIT_MARGIN_SHARE: f64 = 0.5;
 /// Least share of the predicted gain a step must deliver to be accepted.
 const ACCEPT_RATIO: f64 = 0.1;
 
-impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
+impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
     fn name(&self) -> &str {
         "scp-clarabel"
     }
@@ -247,6 +250,10 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
         let (trust, sigma_trust, c_trust) = (self.trust, self.sigma_trust, self.c_trust_ups);
         let upper_at_kink = state.get_iter() % 2 == 0;
         let duals = self.duals.take();
+        let seconds_left = self
+            .budget
+            .remaining()
+            .map_or(f64::INFINITY, |d| d.as_secs_f64());
         let step = problem.problem("linearise-and-solve", |pr| {
             // Each frame stays on its piece of mu = min(gamma1, L - c) within a step, so the linearisation
             // is exact to first order; a frame on the kink tries the upper piece (mu = L - c) on even
@@ -305,7 +312,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
                 c_range: &c_range,
                 curvature: lin.curvature.as_deref(),
             };
-            Ok(qp::solve(&sub))
+            Ok(qp::solve_within_time(&sub, seconds_left))
         })?;
         self.stats.iterations += 1;
         self.stats.subproblems += 1;
@@ -353,6 +360,8 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver {
     fn terminate(&mut self, _state: &ScpState) -> TerminationStatus {
         if self.converged || self.trust < self.min_trust {
             TerminationStatus::Terminated(TerminationReason::SolverConverged)
+        } else if self.budget.expired() {
+            TerminationStatus::Terminated(TerminationReason::Interrupt)
         } else {
             TerminationStatus::NotTerminated
         }
@@ -366,12 +375,12 @@ pub(super) fn run_scp(
     controls: Vec<FrameControl>,
     max_iters: u64,
     tol: f64,
-    deadline: Option<Instant>,
+    budget: Budget,
 ) -> (Vec<FrameControl>, bool, bool, SearchStats) {
     let x0 = pack(&controls);
-    let mut exec = Executor::new(problem, ScpSolver::new(tol))
+    let mut exec = Executor::new(problem, ScpSolver::new(tol, budget))
         .configure(|s| s.param(x0.clone()).max_iters(max_iters));
-    if let Some(d) = deadline {
+    if let Some(d) = budget.deadline() {
         exec = exec.timeout(
             d.saturating_duration_since(Instant::now())
                 .max(Duration::from_millis(1)),
@@ -380,7 +389,10 @@ pub(super) fn run_scp(
     match exec.run() {
         Ok(res) => {
             let reason = res.state().get_termination_reason();
-            let timed_out = matches!(reason, Some(TerminationReason::Timeout));
+            let timed_out = matches!(
+                reason,
+                Some(TerminationReason::Timeout | TerminationReason::Interrupt)
+            );
             let capped = matches!(reason, Some(TerminationReason::MaxItersReached));
             let best = res
                 .state()
@@ -406,7 +418,7 @@ pub(super) fn scp_stage(
     controls: Vec<FrameControl>,
     max_iters: u64,
     settings: &SearchSettings,
-    deadline: Option<Instant>,
+    budget: Budget,
     stats: &mut SearchStats,
     timed_out: &mut bool,
 ) -> (Vec<FrameControl>, bool) {
@@ -415,7 +427,7 @@ pub(super) fn scp_stage(
         controls,
         max_iters,
         settings.tol_progress_units,
-        deadline,
+        budget,
     );
     stats.add(&s);
     *timed_out |= t;

@@ -14,6 +14,7 @@
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
 use super::baseline::{baseline, GreedyGuide, GuideRun};
+use super::bound::lower_bound_within;
 use super::model::FrameControl;
 use super::planner::Planner;
 use super::polish::rounded_and_polished;
@@ -21,11 +22,13 @@ use super::relaxed::{
     count_search, relaxed_plan, Certifier, Relaxation, RelaxedCertificate, StartKind,
 };
 use super::verify::{time_of, PlanPlayer};
-use super::{lower_bound, LowerBound};
+use super::LowerBound;
+use crate::budget::{Budget, Stage, Stop};
 use crate::error::{Error, Result};
 use crate::physics::Control;
 use crate::scene::Scene;
 use crate::sim::{EngineRun, Simulation, Trace};
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 /// How hard `solve` works.
@@ -61,6 +64,9 @@ pub struct SearchSettings {
     pub certificate_starts: usize,
     /// Stop with the best valid plan after this long.
     pub time_limit: Option<Duration>,
+    /// Most frames a run is planned over: a scene whose lower bound needs more is refused
+    /// ([`Error::FrameLimit`]), and no simulated run goes further (the scene's own cap, if lower, holds).
+    pub max_frames: u64,
 }
 
 impl SearchSettings {
@@ -76,6 +82,7 @@ impl SearchSettings {
             wall_radius_units: 40.0,
             certificate_starts: 3,
             time_limit: None,
+            max_frames: crate::budget::DEFAULT_MAX_PLANNED_FRAMES,
         };
         match quality {
             Quality::Fast => SearchSettings {
@@ -113,8 +120,16 @@ pub enum SearchStatus {
         /// `(time - bound) / bound`.
         gap: f64,
     },
-    /// The time limit stopped it; the best valid plan so far is returned.
-    TimeLimit,
+    /// The time limit stopped it in `stopped_in`; the best valid plan so far is returned.
+    TimeLimit {
+        /// The stage that was cut.
+        stopped_in: Stage,
+    },
+    /// The caller's cancel flag stopped it in `stopped_in`; the best valid plan so far is returned.
+    Cancelled {
+        /// The stage that was cut.
+        stopped_in: Stage,
+    },
     /// The scene uses effects the optimiser does not plan (ground, gravity, jumps): the greedy run is
     /// returned.
     GreedyOnly {
@@ -128,15 +143,40 @@ pub enum SearchStatus {
     },
 }
 
+impl SearchStatus {
+    /// The status of a search cut by `budget` in `stage` (the time limit unless the cancel flag is set).
+    pub fn stopped(budget: &Budget, stage: Stage) -> Self {
+        match budget.stop() {
+            Some(Stop::Cancelled) => SearchStatus::Cancelled { stopped_in: stage },
+            _ => SearchStatus::TimeLimit { stopped_in: stage },
+        }
+    }
+
+    /// The stage a budget cut, if one was.
+    pub fn stopped_in(&self) -> Option<Stage> {
+        match self {
+            SearchStatus::TimeLimit { stopped_in } | SearchStatus::Cancelled { stopped_in } => {
+                Some(*stopped_in)
+            }
+            _ => None,
+        }
+    }
+}
+
 impl std::fmt::Display for SearchStatus {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             SearchStatus::Converged { gap } => {
                 write!(f, "converged, {:.3}% above the lower bound", 100.0 * gap)
             }
-            SearchStatus::TimeLimit => {
-                f.write_str("stopped by the time limit with the best valid plan so far")
-            }
+            SearchStatus::TimeLimit { stopped_in } => write!(
+                f,
+                "stopped by the time limit in the {stopped_in} stage, with the best valid plan so far"
+            ),
+            SearchStatus::Cancelled { stopped_in } => write!(
+                f,
+                "cancelled in the {stopped_in} stage, with the best valid plan so far"
+            ),
             SearchStatus::GreedyOnly { reason } => write!(f, "greedy plan returned: {reason}"),
             SearchStatus::NoImprovement { reason } => write!(f, "greedy plan returned: {reason}"),
         }
@@ -234,8 +274,41 @@ pub fn solve_with_progress(
     settings: &SearchSettings,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome> {
+    solve_within(
+        scene,
+        settings,
+        progress,
+        Budget::from_limit(settings.time_limit, None),
+    )
+}
+
+/// [`solve_with_progress`] that also stops when `cancel` is set: a set flag acts like the time limit
+/// expiring at once, in whatever stage is running. The best valid plan so far is returned with status
+/// [`SearchStatus::Cancelled`] naming that stage; [`Error::Stopped`] when nothing valid was found yet.
+/// For callers that replace a solve by a newer one (an editor re-solving after every edit).
+pub fn solve_cancellable(
+    scene: &Scene,
+    settings: &SearchSettings,
+    progress: &mut dyn FnMut(Progress),
+    cancel: &AtomicBool,
+) -> Result<Outcome> {
+    solve_within(
+        scene,
+        settings,
+        progress,
+        Budget::from_limit(settings.time_limit, Some(cancel)),
+    )
+}
+
+/// The solve of every entry point, within `budget` (which covers every level run).
+fn solve_within(
+    scene: &Scene,
+    settings: &SearchSettings,
+    progress: &mut dyn FnMut(Progress),
+    budget: Budget,
+) -> Result<Outcome> {
     let started = Instant::now();
-    let mut best = solve_once(scene, settings, progress)?;
+    let mut best = solve_once(scene, settings, budget, progress)?;
     if !scene.effects.is_air_only() {
         return Ok(best);
     }
@@ -246,24 +319,32 @@ pub fn solve_with_progress(
     };
     let mut stats = best.stats;
     for &quality in lower {
-        let time_limit = match settings.time_limit {
-            Some(limit) => match limit.checked_sub(started.elapsed()) {
-                Some(left) if !left.is_zero() => Some(left),
-                _ => break,
-            },
-            None => None,
-        };
+        if budget.expired() {
+            break;
+        }
         let other = solve_once(
             scene,
             &SearchSettings {
-                time_limit,
+                time_limit: settings.time_limit,
+                max_frames: settings.max_frames,
                 ..SearchSettings::for_quality(quality)
             },
+            budget,
             progress,
-        )?;
+        );
+        // A lower level cut before it had anything valid leaves the plan already found.
+        let other = match other {
+            Err(Error::Stopped { .. }) => break,
+            other => other?,
+        };
         stats.add(&other.stats);
         if other.source == "optimised" && time_of(&other.trace) < time_of(&best.trace) {
             best = other;
+        } else if best.status.stopped_in().is_none() {
+            // The plan kept is this level's, but the time limit (or cancel flag) cut the run after it.
+            if let Some(stage) = other.status.stopped_in() {
+                best.status = SearchStatus::stopped(&budget, stage);
+            }
         }
     }
     // The work of every run.
@@ -327,21 +408,40 @@ impl Finisher<'_> {
     }
 }
 
-/// One run of the search at `settings` (see [`solve_with_progress`]): the stages of the module
-/// documentation in order.
+/// One run of the search at `settings` within `budget` (see [`solve_with_progress`]): the stages of the
+/// module documentation in order.
 fn solve_once(
     scene: &Scene,
     settings: &SearchSettings,
+    budget: Budget,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome> {
     let started = Instant::now();
-    let deadline = settings.time_limit.map(|d| started + d);
+    let bound = lower_bound_within(scene, &scene.corridor()?, &budget)?;
+    if bound.crossing.frames > settings.max_frames {
+        return Err(Error::FrameLimit {
+            scene: scene.origin.clone(),
+            frames: bound.crossing.frames,
+            limit: settings.max_frames,
+        });
+    }
+    // No run goes past the frame limit: the memory of a run (and of every stage after it) grows with its
+    // frames.
+    let scene = &Scene {
+        max_frames: scene.max_frames.min(settings.max_frames),
+        ..scene.clone()
+    };
     let sim = Simulation::new(scene)?;
-    let bound = lower_bound(scene, sim.corridor())?;
+    if budget.expired() {
+        return Err(Error::stopped(budget.stop(), Stage::LowerBound));
+    }
     // Stage 1: seed and baseline.
-    let base = baseline(&sim, scene, &bound);
+    let base = baseline(&sim, scene, &bound, &budget);
     let greedy = &base.greedy.trace;
     let seed = base.seed();
+    if budget.expired() && !greedy.feasible() {
+        return Err(Error::stopped(budget.stop(), Stage::Greedy));
+    }
     progress(Progress::Baseline {
         greedy_frames: greedy.crossing.map(|c| c.frames),
         bound_frames: bound.crossing.frames,
@@ -352,10 +452,14 @@ fn solve_once(
         bound: &bound,
         started,
     };
-    if !scene.effects.is_air_only() {
-        return Ok(plan_jumping_scene(&finisher, settings, deadline));
+    if budget.expired() {
+        let status = SearchStatus::stopped(&budget, Stage::Greedy);
+        return Ok(finisher.greedy_outcome(status, SearchStats::default()));
     }
-    let mut planner = Planner::new(scene, &sim, settings, &bound, seed, deadline);
+    if !scene.effects.is_air_only() {
+        return Ok(plan_jumping_scene(&finisher, settings, budget));
+    }
+    let mut planner = Planner::new(scene, &sim, settings, &bound, seed, budget);
     // Stage 2: the relaxed problem; its margin leaves room for the zigzag of rounded sides.
     let fl = planner.fl;
     let zigzag = fl.tau_s * fl.law.l.max(fl.law.gamma1);
@@ -367,54 +471,26 @@ fn solve_once(
     });
     // No plan crosses before the bound's frame.
     let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
-    let Some(relaxed) = relaxed_plan(
-        &mut planner,
-        progress,
-        warm,
-        n,
-        lo,
-        Relaxation::planning(relaxed_margin),
-    ) else {
-        let status = if planner.timed_out {
-            SearchStatus::TimeLimit
-        } else {
-            SearchStatus::NoImprovement {
+    let relaxation = Relaxation::planning(relaxed_margin);
+    let Some(relaxed) = relaxed_plan(&mut planner, progress, warm, n, lo, relaxation) else {
+        let status = match planner.cut_in {
+            Some(stage) => SearchStatus::stopped(&budget, stage),
+            None => SearchStatus::NoImprovement {
                 reason: "the relaxed search found no valid plan".into(),
-            }
+            },
         };
         return Ok(finisher.greedy_outcome(status, planner.stats));
     };
-    // The certificate: the relaxed optimum at zero margin, from the relaxed plan and the other clean
-    // greedy runs (not from a start at rest, whose first frame is the seed's own).
-    let others = if planner.prefix.is_empty() {
-        &base.clean[1.min(base.clean.len())..]
-    } else {
-        &[]
-    };
     let mut certifier = Certifier::default();
-    certifier.add_start(
+    let sources = certified_sources(
         &mut planner,
-        progress,
-        relaxed.clone(),
-        StartKind::Planned,
+        &mut certifier,
+        &base,
+        relaxed,
+        relaxed_margin,
         lo,
+        progress,
     );
-    for run in others
-        .iter()
-        .take(settings.certificate_starts.saturating_sub(1))
-    {
-        let warm = planner.warm_start(&run.trace);
-        certifier.add_start(&mut planner, progress, warm, StartKind::Greedy, lo);
-    }
-    // Where another start found a faster relaxed line, that line is planned too.
-    let mut sources = vec![(relaxed, relaxed_margin)];
-    if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
-        let (controls, n) = (plan.controls.clone(), plan.controls.len());
-        let relaxation = Relaxation::planning(relaxed_margin);
-        if let Some(r) = count_search(&mut planner, progress, controls, n, lo, relaxation, 1) {
-            sources.push((r, relaxed_margin));
-        }
-    }
     progress(Progress::Finishing);
     // Stages 3 and 4, first with the settings' final margin; if no plan stays valid through rounding and
     // quantisation (a tight margin along a long wall), again with wider ones.
@@ -423,7 +499,7 @@ fn solve_once(
         for (relaxed, margin) in &sources {
             let candidates = rounded_and_polished(&mut planner, relaxed, *margin, final_margin);
             for plan in candidates {
-                if let Some((t, trace)) = quantised_and_verified(&planner, plan.clone()) {
+                if let Some((t, trace)) = quantised_and_verified(&mut planner, plan.clone()) {
                     let limit = best.as_ref().map_or(time_of(greedy), |b| b.0);
                     if t < limit {
                         best = Some((t, trace, plan));
@@ -441,56 +517,98 @@ fn solve_once(
         certifier.add_start(&mut planner, progress, plan.clone(), StartKind::Planned, lo);
     }
     let stats = planner.stats;
-    let relaxed = certifier.certificate();
+    let stopped = planner
+        .cut_in
+        .filter(|_| planner.timed_out)
+        .map(|stage| SearchStatus::stopped(&budget, stage));
     let outcome = match best {
         Some((t, trace, _)) => {
-            let status = if planner.timed_out {
-                SearchStatus::TimeLimit
-            } else {
-                SearchStatus::Converged {
-                    gap: finisher.gap(t),
-                }
-            };
+            let status = stopped.unwrap_or(SearchStatus::Converged {
+                gap: finisher.gap(t),
+            });
             finisher.outcome(trace.controls.clone(), trace, status, stats, "optimised")
         }
         None => finisher.greedy_outcome(
-            if planner.timed_out {
-                SearchStatus::TimeLimit
-            } else {
-                SearchStatus::NoImprovement {
-                    reason: "no optimised plan stayed valid after rounding and quantisation".into(),
-                }
-            },
+            stopped.unwrap_or_else(|| SearchStatus::NoImprovement {
+                reason: "no optimised plan stayed valid after rounding and quantisation".into(),
+            }),
             stats,
         ),
     };
-    Ok(Outcome { relaxed, ..outcome })
+    Ok(Outcome {
+        relaxed: certifier.certificate(),
+        ..outcome
+    })
+}
+
+/// The certificate (the relaxed optimum at the certificate's margin, from the relaxed plan and the other
+/// clean greedy runs; not from a start at rest, whose first frame is the seed's own), and the relaxed
+/// lines to round: the relaxed plan, and the line of another start where it was faster.
+fn certified_sources(
+    planner: &mut Planner,
+    certifier: &mut Certifier,
+    base: &super::baseline::Baseline,
+    relaxed: Vec<FrameControl>,
+    relaxed_margin: f64,
+    lo: usize,
+    progress: &mut dyn FnMut(Progress),
+) -> Vec<(Vec<FrameControl>, f64)> {
+    let others = if planner.prefix.is_empty() {
+        &base.clean[1.min(base.clean.len())..]
+    } else {
+        &[]
+    };
+    certifier.add_start(planner, progress, relaxed.clone(), StartKind::Planned, lo);
+    let more = planner.settings.certificate_starts.saturating_sub(1);
+    for run in others.iter().take(more) {
+        let warm = planner.warm_start(&run.trace);
+        certifier.add_start(planner, progress, warm, StartKind::Greedy, lo);
+    }
+    let mut sources = vec![(relaxed, relaxed_margin)];
+    if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
+        let (controls, n) = (plan.controls.clone(), plan.controls.len());
+        let relaxation = Relaxation::planning(relaxed_margin);
+        if let Some(r) = count_search(planner, progress, controls, n, lo, relaxation, 1) {
+            sources.push((r, relaxed_margin));
+        }
+    }
+    sources
 }
 
 /// Stage 4: `plan` played through the real frame with quantised yaws; its crossing time and trace when it
 /// is valid in f64 and in the engine-exact mode.
-fn quantised_and_verified(planner: &Planner, plan: Vec<FrameControl>) -> Option<(f64, Trace)> {
+fn quantised_and_verified(planner: &mut Planner, plan: Vec<FrameControl>) -> Option<(f64, Trace)> {
     let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan, planner.fl, true);
-    let trace = planner.sim.run(&mut player);
+    let trace = planner.sim.run_within(&mut player, &planner.budget);
+    if trace.interrupted {
+        planner.timed_out = true;
+        planner.note_cut(Stage::Verification);
+        return None;
+    }
     let t = time_of(&trace);
-    (t.is_finite() && planner.sim.run_engine_exact(&trace.controls).feasible())
-        .then_some((t, trace))
+    if !t.is_finite() {
+        return None;
+    }
+    let run = planner
+        .sim
+        .run_engine_exact_within(&trace.controls, &planner.budget);
+    if run.interrupted {
+        planner.timed_out = true;
+        planner.note_cut(Stage::Verification);
+    }
+    run.feasible().then_some((t, trace))
 }
 
 /// Jumping scenes with the Source boost: the policy search of [`super::jumps`]. It keeps a plan only if
 /// it is valid in f64 and engine-exact; greedy stays the answer when it is faster.
-fn plan_jumping_scene(
-    finisher: &Finisher,
-    settings: &SearchSettings,
-    deadline: Option<Instant>,
-) -> Outcome {
+fn plan_jumping_scene(finisher: &Finisher, settings: &SearchSettings, budget: Budget) -> Outcome {
     let mut stats = SearchStats::default();
-    if let Some(plan) = super::jumps::plan_jumps(finisher.sim, settings, deadline) {
+    if let Some(plan) = super::jumps::plan_jumps(finisher.sim, settings, budget) {
         stats.iterations = plan.evaluations;
         let t = plan.best.time();
         if t < time_of(&finisher.greedy.trace) {
             let status = if plan.timed_out {
-                SearchStatus::TimeLimit
+                SearchStatus::stopped(&budget, Stage::Jumps)
             } else {
                 SearchStatus::Converged {
                     gap: finisher.gap(t),
@@ -505,6 +623,9 @@ fn plan_jumping_scene(
                 "optimised",
             );
         }
+    }
+    if budget.expired() {
+        return finisher.greedy_outcome(SearchStatus::stopped(&budget, Stage::Jumps), stats);
     }
     let scene = finisher.sim.scene();
     finisher.greedy_outcome(

@@ -912,6 +912,7 @@ mod tests {
             controls: Vec::new(),
             crossing: None,
             numerical_failure: false,
+            interrupted: false,
         }
     }
 

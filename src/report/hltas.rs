@@ -191,6 +191,7 @@ mod tests {
             controls: Vec::new(),
             crossing: None,
             numerical_failure: false,
+            interrupted: false,
         };
         for (i, &y) in yaws.iter().enumerate() {
             t.frames.push(FrameRecord {

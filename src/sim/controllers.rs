@@ -1,7 +1,8 @@
 //! Controllers: the greedy maximum-acceleration autostrafer TAS tools use today (docs/physics.md section 6),
 //! one-sided strafers, and playback of a planned sequence.
 
-use super::{Controller, Simulation, Trace};
+use super::{Controller, RunSummary, Simulation, Trace};
+use crate::budget::Budget;
 use crate::physics::strafe::{
     max_accel, max_accel_control, max_decel, speed_preserving_cos_theta, strafe_control,
     strafe_keys, theta_from_cos,
@@ -227,34 +228,17 @@ pub const GREEDY_LOOKAHEADS_UNITS: [f64; 24] = {
 /// crossing, else the earliest crossing, else the run that got furthest along the path. Returns the trace
 /// and the look-ahead used.
 pub fn best_greedy(sim: &Simulation, path: &[Vec2], lookaheads: &[f64]) -> (Trace, f64) {
-    let guide = Greedy::new(path.to_vec(), 0.0);
-    let mut best: Option<((u8, f64), Trace, f64)> = None;
-    for &la in lookaheads {
-        let t = sim.run(&mut Greedy::new(path.to_vec(), la));
-        let r = rank(&t, &guide);
-        if best.as_ref().is_none_or(|(b, _, _)| r < *b) {
-            best = Some((r, t, la));
-        }
-    }
-    match best {
-        Some((_, t, la)) => (t, la),
-        None => {
-            let la = GREEDY_LOOKAHEADS_UNITS[9];
-            (sim.run(&mut Greedy::new(path.to_vec(), la)), la)
-        }
-    }
+    let (t, la, _) = best_capped_greedy_within(sim, path, lookaheads, &[], &Budget::unlimited());
+    (t, la)
 }
 
 /// Sort key of a run: feasible crossings first by time, then infeasible crossings by time, then the rest
 /// by how far along the guide path they ended (further is better).
-fn rank(t: &Trace, guide: &Greedy) -> (u8, f64) {
+fn rank(t: &RunSummary, guide: &Greedy) -> (u8, f64) {
     match (t.crossing, t.feasible()) {
         (Some(c), true) => (0, c.time),
         (Some(c), false) => (1, c.time),
-        (None, _) => {
-            let end = t.frames.last().map_or(t.start.pos, |f| f.pos);
-            (2, -guide.project(end))
-        }
+        (None, _) => (2, -guide.project(t.end_pos)),
     }
 }
 
@@ -266,17 +250,53 @@ pub fn best_capped_greedy(
     lookaheads: &[f64],
     caps_ups: &[f64],
 ) -> (Trace, f64, Option<f64>) {
+    best_capped_greedy_within(sim, path, lookaheads, caps_ups, &Budget::unlimited())
+}
+
+/// [`best_capped_greedy`] within `budget`: the sweep stops when it expires and returns the best run so
+/// far (an interrupted run if none ended; see [`Trace::interrupted`]). Each candidate is run as a
+/// [`RunSummary`] and only the best is replayed with its frames, so memory holds one run, not one per
+/// candidate.
+pub fn best_capped_greedy_within(
+    sim: &Simulation,
+    path: &[Vec2],
+    lookaheads: &[f64],
+    caps_ups: &[f64],
+    budget: &Budget,
+) -> (Trace, f64, Option<f64>) {
     let guide = Greedy::new(path.to_vec(), 0.0);
-    let (t, la) = best_greedy(sim, path, lookaheads);
-    let mut best = (rank(&t, &guide), t, la, None);
-    for &cap in caps_ups {
+    let make = |la: f64, cap: Option<f64>| {
+        let g = Greedy::new(path.to_vec(), la);
+        match cap {
+            Some(cap) => g.with_speed_cap(cap),
+            None => g,
+        }
+    };
+    // (rank, run, look-ahead, cap) of the best run so far.
+    type Best = ((u8, f64), RunSummary, f64, Option<f64>);
+    let mut best: Option<Best> = None;
+    'sweep: for cap in std::iter::once(None).chain(caps_ups.iter().copied().map(Some)) {
         for &la in lookaheads {
-            let t = sim.run(&mut Greedy::new(path.to_vec(), la).with_speed_cap(cap));
-            let r = rank(&t, &guide);
-            if r < best.0 {
-                best = (r, t, la, Some(cap));
+            if best.is_some() && budget.expired() {
+                break 'sweep;
+            }
+            let run = sim.run_summary(&mut make(la, cap), budget);
+            let r = rank(&run, &guide);
+            if best.as_ref().is_none_or(|(b, ..)| r < *b) {
+                best = Some((r, run, la, cap));
             }
         }
     }
-    (best.1, best.2, best.3)
+    let (la, cap, interrupted) = match best {
+        Some((_, run, la, cap)) => (la, cap, run.interrupted),
+        None => (GREEDY_LOOKAHEADS_UNITS[9], None, false),
+    };
+    // A run that ended is replayed whole (its length is known to be finite and it is the result); an
+    // interrupted one only within the budget.
+    let replay_budget = if interrupted {
+        *budget
+    } else {
+        Budget::unlimited()
+    };
+    (sim.run_within(&mut make(la, cap), &replay_budget), la, cap)
 }

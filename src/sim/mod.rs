@@ -10,6 +10,7 @@ pub mod abh;
 pub mod controllers;
 pub mod trace;
 
+use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 use crate::error::Result;
 use crate::geometry::{BoundaryKind, Corridor};
 use crate::physics::{Control, Effect, PlayerState, Stepper, Vec2};
@@ -107,6 +108,12 @@ impl<'s> Simulation<'s> {
     /// Plays `controls` in the engine-exact mode (f32 state, anglemod yaw; docs/physics.md section 1) through the
     /// same walls, rule lines and finish line. The walls are queried in f64 on the f32 positions.
     pub fn run_engine_exact(&self, controls: &[Control]) -> EngineRun {
+        self.run_engine_exact_within(controls, &Budget::unlimited())
+    }
+
+    /// [`Self::run_engine_exact`] that stops when `budget` expires; a replay cut short is marked
+    /// `interrupted` and is not [`EngineRun::feasible`].
+    pub fn run_engine_exact_within(&self, controls: &[Control], budget: &Budget) -> EngineRun {
         use crate::physics::engine_exact::{engine_wish, from_engine_state, to_engine_state};
         let game: Stepper<f32> = Stepper::new(&self.scene.vars, self.scene.effects);
         let tau = f64::from(game.frame_time_s());
@@ -116,8 +123,13 @@ impl<'s> Simulation<'s> {
             broke_rule: false,
             min_clearance: self.corridor.clearance(self.scene.start.pos),
             finite: true,
+            interrupted: false,
         };
         for (i, c) in controls.iter().enumerate() {
+            if i as u64 % FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
+                run.interrupted = true;
+                break;
+            }
             let before = from_engine_state(&g).pos;
             game.pre_move(&mut g, &engine_wish(c));
             if self.solid_walls {
@@ -146,10 +158,20 @@ impl<'s> Simulation<'s> {
 
     /// Runs `controller` from the scene's start until the finish line is crossed or the frame cap.
     pub fn run(&self, controller: &mut dyn Controller) -> Trace {
+        self.run_within(controller, &Budget::unlimited())
+    }
+
+    /// [`Self::run`] that stops when `budget` expires; a run cut short is marked `interrupted` (it has no
+    /// crossing, so it is not feasible).
+    pub fn run_within(&self, controller: &mut dyn Controller, budget: &Budget) -> Trace {
         let tau = self.stepper.frame_time_s();
         let mut s = self.scene.start;
         let mut trace = Trace::new(controller.name(), &s, self.corridor.clearance(s.pos));
         for frame in 1..=self.scene.max_frames {
+            if frame % FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
+                trace.interrupted = true;
+                break;
+            }
             let c = controller.control(frame, &s, self);
             let theta = c.theta_rad(s.vel);
             let out = self.frame(&mut s, &c);
@@ -187,6 +209,70 @@ impl<'s> Simulation<'s> {
         }
         trace
     }
+
+    /// Runs `controller` like [`Self::run_within`] but keeps only the summary of the run, not its frames:
+    /// memory that does not grow with the run's length, for sweeps that keep only their best run (and
+    /// replay it with [`Self::run`]).
+    pub fn run_summary(&self, controller: &mut dyn Controller, budget: &Budget) -> RunSummary {
+        let tau = self.stepper.frame_time_s();
+        let mut s = self.scene.start;
+        let mut summary = RunSummary {
+            crossing: None,
+            end_pos: s.pos,
+            frames_run: 0,
+            collisions: 0,
+            broke_rule: false,
+            numerical_failure: false,
+            interrupted: false,
+        };
+        for frame in 1..=self.scene.max_frames {
+            if frame % FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
+                summary.interrupted = true;
+                break;
+            }
+            let c = controller.control(frame, &s, self);
+            let out = self.frame(&mut s, &c);
+            if !s.is_finite() {
+                summary.numerical_failure = true;
+                break;
+            }
+            summary.frames_run = frame;
+            summary.end_pos = s.pos;
+            summary.collisions += out.contacts;
+            summary.broke_rule |= out.broke_rule;
+            if let Some(f) = self.scene.finish.crossing_fraction(out.from, s.pos) {
+                summary.crossing = Some(Crossing::new(frame, f, tau));
+                break;
+            }
+        }
+        summary
+    }
+}
+
+/// What a run did, without its frames ([`Simulation::run_summary`]): the same verdicts as its [`Trace`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunSummary {
+    /// The finish crossing, if reached.
+    pub crossing: Option<Crossing>,
+    /// Hull centre after the last frame run.
+    pub end_pos: Vec2,
+    /// Frames run.
+    pub frames_run: u64,
+    /// Total wall contacts.
+    pub collisions: u32,
+    /// A frame's move crossed into a rule boundary.
+    pub broke_rule: bool,
+    /// A state became NaN or infinite.
+    pub numerical_failure: bool,
+    /// The budget ran out before the run ended.
+    pub interrupted: bool,
+}
+
+impl RunSummary {
+    /// As [`Trace::feasible`]: crossed the line, no rule broken, every state finite.
+    pub fn feasible(&self) -> bool {
+        self.crossing.is_some() && !self.broke_rule && !self.numerical_failure
+    }
 }
 
 /// A plan played in the engine-exact mode.
@@ -200,12 +286,14 @@ pub struct EngineRun {
     pub min_clearance: f64,
     /// Every state stayed finite.
     pub finite: bool,
+    /// The budget ran out before the replay ended (the plan is unverified).
+    pub interrupted: bool,
 }
 
 impl EngineRun {
     /// Reached the line without breaking a rule.
     pub fn feasible(&self) -> bool {
-        self.crossing.is_some() && !self.broke_rule && self.finite
+        self.crossing.is_some() && !self.broke_rule && self.finite && !self.interrupted
     }
 }
 

@@ -70,6 +70,8 @@ pub struct Trace {
     pub crossing: Option<Crossing>,
     /// A state became NaN or infinite (the run stopped there).
     pub numerical_failure: bool,
+    /// The budget (time limit or cancellation) ran out before the run ended.
+    pub interrupted: bool,
 }
 
 impl Trace {
@@ -94,6 +96,7 @@ impl Trace {
             controls: Vec::new(),
             crossing: None,
             numerical_failure: false,
+            interrupted: false,
         }
     }
 
