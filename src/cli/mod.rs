@@ -6,6 +6,7 @@ pub mod args;
 pub mod bench;
 pub mod calc;
 pub mod report_cmd;
+pub mod serve;
 pub mod simulate;
 pub mod solve;
 
@@ -121,6 +122,7 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
         Command::Solve(a) => solve::run(a),
         Command::Report(a) => report_cmd::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Serve(a) => serve::run(a),
         Command::Calc(c) => {
             let figures = calc::run(&c.form)?;
             if calc::wants_json(&c.form) {

@@ -42,8 +42,10 @@ mod file;
 mod locate;
 pub mod shorthand;
 mod validate;
+pub mod edit;
 
 pub use crate::geometry::{BoundaryKind, FinishLine, FinishPoint, Wall};
+pub use edit::SceneEdit;
 pub use file::{EngineFile, FinishFile, Point, SceneFile, StartFile, WallFile};
 pub use shorthand::{Bend90, Hairpin, Lane, START_OFFSET_UNITS};
 
