@@ -32,7 +32,15 @@ impl Drop for Served {
 fn serve(extra: &[&str]) -> Served {
     let mut child = Command::new(env!("CARGO_BIN_EXE_strafeopt"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["serve", "--port", "0", "--quality", "fast", "--time-limit", "60"])
+        .args([
+            "serve",
+            "--port",
+            "0",
+            "--quality",
+            "fast",
+            "--time-limit",
+            "60",
+        ])
         .args(extra)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -76,7 +84,13 @@ fn raw(addr: SocketAddr, request: &[u8]) -> (u16, String) {
     (status, body)
 }
 
-fn request(addr: SocketAddr, method: &str, path: &str, content_type: &str, body: &[u8]) -> (u16, String) {
+fn request(
+    addr: SocketAddr,
+    method: &str,
+    path: &str,
+    content_type: &str,
+    body: &[u8],
+) -> (u16, String) {
     let mut bytes = format!(
         "{method} {path} HTTP/1.1\r\nHost: {addr}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\n\r\n",
         body.len()
@@ -87,11 +101,20 @@ fn request(addr: SocketAddr, method: &str, path: &str, content_type: &str, body:
 }
 
 fn get(addr: SocketAddr, path: &str) -> (u16, String) {
-    raw(addr, format!("GET {path} HTTP/1.1\r\nHost: {addr}\r\n\r\n").as_bytes())
+    raw(
+        addr,
+        format!("GET {path} HTTP/1.1\r\nHost: {addr}\r\n\r\n").as_bytes(),
+    )
 }
 
 fn post_solve(addr: SocketAddr, body: &str) -> (u16, Value) {
-    let (status, text) = request(addr, "POST", "/api/solve", "application/json", body.as_bytes());
+    let (status, text) = request(
+        addr,
+        "POST",
+        "/api/solve",
+        "application/json",
+        body.as_bytes(),
+    );
     let value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}: {text}"));
     (status, value)
 }
@@ -111,7 +134,10 @@ fn assert_refused(answer: (u16, Value), status: u16, word: &str, contains: &str)
     assert_eq!(body["status"], word, "{body}");
     let error = body["error"].as_str().unwrap_or_default();
     assert!(!error.contains('\n'), "{error:?} is more than a line");
-    assert!(error.contains(contains), "{error:?} should say {contains:?}");
+    assert!(
+        error.contains(contains),
+        "{error:?} should say {contains:?}"
+    );
 }
 
 fn assert_alive(addr: SocketAddr) {
@@ -125,23 +151,48 @@ fn malformed_and_odd_requests_get_one_line_answers() {
     for (body, says) in [
         ("{", "EOF while parsing"),
         ("not json", "expected ident"),
-        ("[]", "invalid type"),
-        (r#"{"scene": 5, "quality": "fast"}"#, "invalid type: integer"),
+        ("[]", "invalid length 0"),
+        (
+            r#"{"scene": 5, "quality": "fast"}"#,
+            "invalid type: integer",
+        ),
         (r#"{"quality": "fast"}"#, "missing field `scene`"),
     ] {
         assert_refused(post_solve(s.addr, body), 400, "bad-request", says);
     }
     let mut edit = json!({ "scene": bend_edit(), "quality": "fast" });
     edit["scene"]["walls"][0]["colour"] = json!("red");
-    assert_refused(post_solve(s.addr, &edit.to_string()), 400, "bad-request", "unknown field `colour`");
+    assert_refused(
+        post_solve(s.addr, &edit.to_string()),
+        400,
+        "bad-request",
+        "unknown field `colour`",
+    );
     let edit = json!({ "scene": bend_edit(), "quality": "slow" });
-    assert_refused(post_solve(s.addr, &edit.to_string()), 422, "invalid", "fast, balanced or exact");
+    assert_refused(
+        post_solve(s.addr, &edit.to_string()),
+        422,
+        "invalid",
+        "fast, balanced or exact",
+    );
     // Not JSON by its type (a form post from another site), a missing route, a wrong method, a foreign Host.
-    let (status, _) = request(s.addr, "POST", "/api/solve", "text/plain", solve_body(&bend_edit()).as_bytes());
+    let (status, _) = request(
+        s.addr,
+        "POST",
+        "/api/solve",
+        "text/plain",
+        solve_body(&bend_edit()).as_bytes(),
+    );
     assert_eq!(status, 415);
     assert_eq!(get(s.addr, "/nowhere").0, 404);
-    assert_eq!(request(s.addr, "DELETE", "/api/solve", "application/json", b"").0, 405);
-    let foreign = raw(s.addr, b"GET /api/scene HTTP/1.1\r\nHost: attacker.example:80\r\n\r\n");
+    assert_eq!(
+        request(s.addr, "DELETE", "/api/solve", "application/json", b"").0,
+        405
+    );
+    let foreign = raw(
+        s.addr,
+        b"GET /api/scene HTTP/1.1\r\nHost: attacker.example:80\r\n\r\n",
+    );
     assert_eq!(foreign.0, 403);
     assert_eq!(raw(s.addr, b"BREW /pot HTCPCP/1.0 \x00\r\n\r\n").0, 400);
     assert_alive(s.addr);
@@ -156,7 +207,11 @@ fn oversized_requests_are_refused_before_they_are_read() {
     assert_eq!(status, 413, "{body}");
     assert!(body.contains("at most 1048576"), "{body}");
     // A head over 16 KiB, too many headers, a chunked body.
-    let long = format!("GET / HTTP/1.1\r\nHost: {}\r\nX-Long: {}\r\n\r\n", s.addr, "a".repeat(20_000));
+    let long = format!(
+        "GET / HTTP/1.1\r\nHost: {}\r\nX-Long: {}\r\n\r\n",
+        s.addr,
+        "a".repeat(20_000)
+    );
     assert_eq!(raw(s.addr, long.as_bytes()).0, 431);
     let many: String = (0..60).map(|i| format!("X-H{i}: {i}\r\n")).collect();
     let many = format!("GET / HTTP/1.1\r\nHost: {}\r\n{many}\r\n", s.addr);
@@ -170,10 +225,17 @@ fn oversized_requests_are_refused_before_they_are_read() {
     let mut edit = bend_edit();
     edit.walls.push(strafeopt::scene::edit::WallEdit {
         kind: strafeopt::scene::BoundaryKind::Rule,
-        points: (0..2500).map(|i| [i as f64, -300.0 - (i % 2) as f64]).collect(),
+        points: (0..2500)
+            .map(|i| [i as f64, -300.0 - (i % 2) as f64])
+            .collect(),
         closed: false,
     });
-    assert_refused(post_solve(s.addr, &solve_body(&edit)), 422, "invalid", "at most 2000");
+    assert_refused(
+        post_solve(s.addr, &solve_body(&edit)),
+        422,
+        "invalid",
+        "at most 2000",
+    );
     assert_alive(s.addr);
 }
 
@@ -187,29 +249,61 @@ fn nan_and_infinite_coordinates_are_refused_with_their_key() {
     // JSON has no NaN or infinity: the tokens, an overflowing literal and the `null` a browser sends for
     // them are malformed requests.
     for (bad, says) in [
-        (r#""position":[NaN,80.0]"#, "expected value"),
-        (r#""position":[Infinity,80.0]"#, "expected value"),
-        (r#""position":[-inf,80.0]"#, "expected value"),
+        (r#""position":[NaN,80.0]"#, "at line 1 column"),
+        (r#""position":[Infinity,80.0]"#, "at line 1 column"),
+        (
+            r#""position":[-inf,80.0]"#,
+            "invalid number at line 1 column",
+        ),
         (r#""position":[1e999,80.0]"#, "number out of range"),
-        (r#""position":[null,80.0]"#, "invalid type: null, expected f64"),
+        (
+            r#""position":[null,80.0]"#,
+            "invalid type: null, expected f64",
+        ),
     ] {
-        assert_refused(post_solve(s.addr, &good.replacen(start, bad, 1)), 400, "bad-request", says);
+        assert_refused(
+            post_solve(s.addr, &good.replacen(start, bad, 1)),
+            400,
+            "bad-request",
+            says,
+        );
     }
     // Finite but beyond any map: the validator's error, at the key and the line of the saved scene.
     let mut edit = bend_edit();
     edit.start.position = [1e308, 80.0];
     let (status, body) = post_solve(s.addr, &solve_body(&edit));
-    assert_refused((status, body.clone()), 422, "invalid", "start.position: got [1e308, 80]");
+    assert_refused(
+        (status, body.clone()),
+        422,
+        "invalid",
+        "start.position: got [1e308, 80]",
+    );
     assert_eq!(body["key"], "start.position");
-    assert!(body["error"].as_str().unwrap_or_default().starts_with("scene.toml:"), "{body}");
+    assert!(
+        body["error"]
+            .as_str()
+            .unwrap_or_default()
+            .starts_with("scene.toml:"),
+        "{body}"
+    );
     let mut edit = bend_edit();
     edit.walls[0].points[3] = [-1e300, 0.0];
     let (status, body) = post_solve(s.addr, &solve_body(&edit));
-    assert_refused((status, body.clone()), 422, "invalid", "point 3 is at (-1e300, 0)");
+    assert_refused(
+        (status, body.clone()),
+        422,
+        "invalid",
+        "point 3 is at (-1e300, 0)",
+    );
     assert_eq!(body["key"], "walls[0].points");
     let mut edit = bend_edit();
     edit.start.velocity = [f64::MAX, f64::MAX];
-    assert_refused(post_solve(s.addr, &solve_body(&edit)), 422, "invalid", "start.velocity");
+    assert_refused(
+        post_solve(s.addr, &solve_body(&edit)),
+        422,
+        "invalid",
+        "start.velocity",
+    );
     assert_alive(s.addr);
 }
 
@@ -224,12 +318,22 @@ fn scenes_with_no_valid_path_say_so() {
         closed: false,
     });
     let (status, body) = post_solve(s.addr, &solve_body(&edit));
-    assert_refused((status, body.clone()), 422, "invalid", "no path for the hull");
+    assert_refused(
+        (status, body.clone()),
+        422,
+        "invalid",
+        "no path for the hull",
+    );
     assert_eq!(body["key"], "finish");
     // A way through, but a frame cap too short for any run to reach the line: the solver's answer.
     let mut edit = bend_edit();
     edit.max_frames = Some(100);
-    assert_refused(post_solve(s.addr, &solve_body(&edit)), 200, "no-path", "no valid path");
+    assert_refused(
+        post_solve(s.addr, &solve_body(&edit)),
+        200,
+        "no-path",
+        "no valid path",
+    );
     // Nothing was solved, so there is nothing to download.
     assert_eq!(get(s.addr, "/download/scene.toml").0, 404);
     assert_alive(s.addr);
@@ -268,20 +372,38 @@ fn a_second_quick_edit_supersedes_the_first_and_gets_its_own_result() {
 
     assert_eq!(first_status, 200, "{first_answer}");
     assert_eq!(first_answer["status"], "superseded", "{first_answer}");
-    assert_eq!(first_answer["superseded_by"], answer["id"], "{first_answer} {answer}");
+    assert_eq!(
+        first_answer["superseded_by"], answer["id"],
+        "{first_answer} {answer}"
+    );
     assert_eq!(status, 200, "{answer}");
     assert_eq!(answer["status"], "solved", "{answer}");
 
     // The answer is the second scene's own solve.
-    let scene = second.validate("second.toml").unwrap_or_else(|e| panic!("{e}"));
+    let scene = second
+        .validate("second.toml")
+        .unwrap_or_else(|e| panic!("{e}"));
     let expected = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
         .unwrap_or_else(|e| panic!("{e}"));
-    let crossing = expected.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
+    let crossing = expected
+        .trace
+        .crossing
+        .unwrap_or_else(|| panic!("no crossing"));
     let summary = &answer["summary"];
-    assert_eq!(summary["frames"].as_u64(), Some(crossing.frames), "{summary}");
+    assert_eq!(
+        summary["frames"].as_u64(),
+        Some(crossing.frames),
+        "{summary}"
+    );
     let time = summary["time"].as_f64().unwrap_or(f64::NAN);
-    assert!((time - crossing.time).abs() < 1e-9, "{time} against {}", crossing.time);
-    let first_scene = first.validate("first.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        (time - crossing.time).abs() < 1e-9,
+        "{time} against {}",
+        crossing.time
+    );
+    let first_scene = first
+        .validate("first.toml")
+        .unwrap_or_else(|e| panic!("{e}"));
     let first_bound = first_scene
         .corridor()
         .and_then(|c| strafeopt::optimise::lower_bound(&first_scene, &c))
@@ -296,7 +418,10 @@ fn a_second_quick_edit_supersedes_the_first_and_gets_its_own_result() {
     let runs = answer["runs"].as_array().cloned().unwrap_or_default();
     assert_eq!(runs.len(), 2);
     assert_eq!(runs[1]["label"], "optimised");
-    assert_eq!(runs[1]["x"].as_array().map(Vec::len), Some(expected.trace.frames.len() + 1));
+    assert_eq!(
+        runs[1]["x"].as_array().map(Vec::len),
+        Some(expected.trace.frames.len() + 1)
+    );
 
     // The downloads are the second scene's: its TOML reads back as the same scene.
     let (status, toml) = get(addr, "/download/scene.toml");
@@ -324,13 +449,18 @@ fn the_page_is_self_contained() {
     // Nothing from elsewhere: no absolute URL other than the SVG namespace.
     for (i, _) in page.match_indices("http") {
         let rest = &page[i..];
-        assert!(rest.starts_with("http://www.w3.org/2000/svg"), "{}", &rest[..rest.len().min(60)]);
+        assert!(
+            rest.starts_with("http://www.w3.org/2000/svg"),
+            "{}",
+            &rest[..rest.len().min(60)]
+        );
     }
     let (_, scene) = get(s.addr, "/api/scene");
     let scene: Value = serde_json::from_str(&scene).unwrap_or_default();
     assert_eq!(scene["quality"], "fast");
     assert_eq!(scene["time_limit_s"], 60.0);
-    let edit: SceneEdit = serde_json::from_value(scene["scene"].clone()).unwrap_or_else(|e| panic!("{e}"));
+    let edit: SceneEdit =
+        serde_json::from_value(scene["scene"].clone()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(edit, bend_edit());
 }
 
@@ -358,7 +488,8 @@ fn any_json() -> impl Strategy<Value = Value> {
     let leaf = prop_oneof![
         Just(Value::Null),
         any::<bool>().prop_map(Value::from),
-        any::<f64>().prop_map(|v| serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number)),
+        any::<f64>()
+            .prop_map(|v| serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number)),
         any::<i64>().prop_map(Value::from),
         "[a-z\\-]{0,12}".prop_map(Value::from),
     ];

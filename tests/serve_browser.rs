@@ -38,7 +38,14 @@ fn temp_dir(name: &str) -> PathBuf {
 fn serve() -> (Killed, SocketAddr) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_strafeopt"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["serve", "scenarios/hl-bend90-100fps.toml", "--port", "0", "--quality", "fast"])
+        .args([
+            "serve",
+            "scenarios/hl-bend90-100fps.toml",
+            "--port",
+            "0",
+            "--quality",
+            "fast",
+        ])
         .args(["--time-limit", "60"])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -60,14 +67,28 @@ fn serve() -> (Killed, SocketAddr) {
     (server, addr)
 }
 
-/// A plain GET; returns the body.
+/// A plain GET; returns the body (read up to its Content-Length: Chromium keeps the connection open).
 fn http_get(addr: SocketAddr, path: &str) -> String {
-    let mut s = TcpStream::connect(addr).unwrap_or_else(|e| panic!("connect {addr}: {e}"));
+    let s = TcpStream::connect(addr).unwrap_or_else(|e| panic!("connect {addr}: {e}"));
     let _ = s.set_read_timeout(Some(Duration::from_secs(30)));
-    let _ = write!(s, "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n");
-    let mut answer = String::new();
-    let _ = s.read_to_string(&mut answer);
-    answer.split_once("\r\n\r\n").map(|(_, b)| b.to_string()).unwrap_or_default()
+    let _ = write!(
+        &s,
+        "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"
+    );
+    let mut reader = BufReader::new(s);
+    let mut length = 0usize;
+    let mut line = String::new();
+    while reader.read_line(&mut line).is_ok_and(|n| n > 0) && line != "\r\n" {
+        if let Some((name, value)) = line.split_once(':') {
+            if name.eq_ignore_ascii_case("content-length") {
+                length = value.trim().parse().unwrap_or(0);
+            }
+        }
+        line.clear();
+    }
+    let mut body = vec![0u8; length];
+    let _ = reader.read_exact(&mut body);
+    String::from_utf8_lossy(&body).into_owned()
 }
 
 /// Headless Chromium on `url` with the DevTools protocol on a free port.
@@ -100,7 +121,10 @@ fn chromium(profile: &Path, url: &str) -> (Killed, u16) {
         if let Some(port) = text.lines().next().and_then(|l| l.trim().parse().ok()) {
             return (browser, port);
         }
-        assert!(started.elapsed() < PATIENCE, "chromium wrote no DevToolsActivePort");
+        assert!(
+            started.elapsed() < PATIENCE,
+            "chromium wrote no DevToolsActivePort"
+        );
         std::thread::sleep(Duration::from_millis(50));
     }
 }
@@ -117,13 +141,19 @@ impl DevTools {
         let addr = SocketAddr::from(([127, 0, 0, 1], port));
         let started = Instant::now();
         let ws_path = loop {
-            let list: Value = serde_json::from_str(&http_get(addr, "/json/list")).unwrap_or_default();
+            let list: Value =
+                serde_json::from_str(&http_get(addr, "/json/list")).unwrap_or_default();
             let found = list.as_array().and_then(|targets| {
                 targets
                     .iter()
-                    .find(|t| t["type"] == "page" && t["url"].as_str().is_some_and(|u| u.starts_with(url)))
+                    .find(|t| {
+                        t["type"] == "page" && t["url"].as_str().is_some_and(|u| u.starts_with(url))
+                    })
                     .and_then(|t| t["webSocketDebuggerUrl"].as_str())
-                    .and_then(|u| u.split_once(&format!("{port}")).map(|(_, path)| path.to_string()))
+                    .and_then(|u| {
+                        u.split_once(&format!("{port}"))
+                            .map(|(_, path)| path.to_string())
+                    })
             });
             if let Some(path) = found {
                 break path;
@@ -142,7 +172,9 @@ impl DevTools {
         let mut head = Vec::new();
         let mut byte = [0u8; 1];
         while !head.ends_with(b"\r\n\r\n") {
-            stream.read_exact(&mut byte).unwrap_or_else(|e| panic!("handshake: {e}"));
+            stream
+                .read_exact(&mut byte)
+                .unwrap_or_else(|e| panic!("handshake: {e}"));
             head.push(byte[0]);
         }
         let head = String::from_utf8_lossy(&head);
@@ -158,7 +190,9 @@ impl DevTools {
         let id = self.next_id;
         self.next_id += 1;
         let message = json!({ "id": id, "method": method, "params": params }).to_string();
-        self.ws.send(Message::Text(message.into())).unwrap_or_else(|e| panic!("{method}: {e}"));
+        self.ws
+            .send(Message::Text(message.into()))
+            .unwrap_or_else(|e| panic!("{method}: {e}"));
         loop {
             let reply = self.ws.read().unwrap_or_else(|e| panic!("{method}: {e}"));
             if let Message::Text(text) = reply {
@@ -202,15 +236,21 @@ impl DevTools {
     }
 }
 
-const RESULT_ID: &str = "document.getElementById('paths').getAttribute('data-result-id')";
+const RESULT_ID: &str =
+    "(function () { var p = document.getElementById('paths'); return p && p.getAttribute('data-result-id'); })()";
 const TABLE_TIME: &str = "document.getElementById('time-optimised').textContent";
-const PLAN_DRAWN: &str = "Array.from(document.querySelectorAll('#paths [data-run=optimised] polyline'))\
+const PLAN_DRAWN: &str =
+    "Array.from(document.querySelectorAll('#paths [data-run=optimised] polyline'))\
      .map(function (p) { return p.getAttribute('points'); }).join(' ')";
 
 #[test]
 fn dragging_a_wall_vertex_redraws_the_plan_with_the_time_solve_gives() {
     if !Path::new(CHROMIUM).exists() {
-        assert_ne!(std::env::var("CI").as_deref(), Ok("true"), "{CHROMIUM} is missing on CI");
+        assert_ne!(
+            std::env::var("CI").as_deref(),
+            Ok("true"),
+            "{CHROMIUM} is missing on CI"
+        );
         println!("serve_browser: {CHROMIUM} not found; the browser test is skipped");
         return;
     }
@@ -224,7 +264,10 @@ fn dragging_a_wall_vertex_redraws_the_plan_with_the_time_solve_gives() {
     let first_id = page.wait_for(RESULT_ID, "the first plan", |v| v.is_string());
     let first_time = page.eval(TABLE_TIME);
     let first_plan = page.eval(PLAN_DRAWN);
-    assert!(first_plan.as_str().is_some_and(|p| p.len() > 1000), "{first_plan}");
+    assert!(
+        first_plan.as_str().is_some_and(|p| p.len() > 1000),
+        "{first_plan}"
+    );
 
     // Drag the inner corner of the bend (walls[0], point 1) up and to the left with the mouse.
     let handle = page.eval(
@@ -249,22 +292,36 @@ fn dragging_a_wall_vertex_redraws_the_plan_with_the_time_solve_gives() {
     let new_plan = page.eval(PLAN_DRAWN);
     assert_ne!(new_plan, first_plan, "the drawn plan did not change");
     assert_ne!(new_time, first_time, "the time in the table did not change");
-    let moved = page.eval("document.querySelector('circle[data-wall=\"0\"][data-point=\"1\"] title').textContent");
-    assert!(moved.as_str().is_some_and(|t| !t.contains("(1040, 160)")), "{moved}");
+    let moved = page.eval(
+        "document.querySelector('circle[data-wall=\"0\"][data-point=\"1\"] title').textContent",
+    );
+    assert!(
+        moved.as_str().is_some_and(|t| !t.contains("(1040, 160)")),
+        "{moved}"
+    );
     let error_shown = page.eval("!document.getElementById('edit-error').hidden");
     assert_eq!(error_shown, json!(false));
 
     // The table's time is what `solve` gives for the scene the page saves.
     let saved = dir.join("saved.toml");
-    std::fs::write(&saved, http_get(addr, "/download/scene.toml")).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(&saved, http_get(addr, "/download/scene.toml"))
+        .unwrap_or_else(|e| panic!("{e}"));
     let out = Command::new(env!("CARGO_BIN_EXE_strafeopt"))
         .args(["solve", "--quality", "fast", "--json"])
         .arg(&saved)
         .output()
         .unwrap_or_else(|e| panic!("{e}"));
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let solved: Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
     let time = solved["time"].as_f64().unwrap_or(f64::NAN);
-    assert_eq!(new_time, json!(format!("{time:.6}")), "page {new_id}, solve {solved}");
+    assert_eq!(
+        new_time,
+        json!(format!("{time:.6}")),
+        "page {new_id}, solve {solved}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -22,7 +22,7 @@ pub fn run(args: &ServeArgs) -> Result<String> {
         return Err(Error::invalid(
             "--time-limit",
             args.time_limit,
-            &format!("a finite number of seconds above 0 and at most {MAX_TIME_LIMIT_S}"),
+            format!("a finite number of seconds above 0 and at most {MAX_TIME_LIMIT_S}"),
         ));
     }
     let limit = time_limit(args.time_limit)?;

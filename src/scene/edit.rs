@@ -196,7 +196,8 @@ impl SceneEdit {
                         let _ = writeln!(s, "{key} = {b}");
                     }
                     serde_json::Value::Number(n) => {
-                        let _ = writeln!(s, "{key} = {}", toml_float(n.as_f64().unwrap_or(f64::NAN)));
+                        let _ =
+                            writeln!(s, "{key} = {}", toml_float(n.as_f64().unwrap_or(f64::NAN)));
                     }
                     _ => {}
                 }
@@ -286,7 +287,8 @@ mod tests {
 
     #[test]
     fn json_round_trips_and_numbers_read_back_exactly() {
-        let mut edit = SceneEdit::from_toml_str(BEND, "bend.toml").unwrap_or_else(|e| panic!("{e}"));
+        let mut edit =
+            SceneEdit::from_toml_str(BEND, "bend.toml").unwrap_or_else(|e| panic!("{e}"));
         edit.start.position = [40.1 + 1e-13, 80.0 / 3.0];
         edit.engine.vars.airaccelerate = Some(0.1 + 0.2);
         edit.name = "a \"quoted\"\nname".to_string();
@@ -301,7 +303,8 @@ mod tests {
 
     #[test]
     fn a_bad_point_is_an_error_at_its_own_line_and_key() {
-        let mut edit = SceneEdit::from_toml_str(BEND, "bend.toml").unwrap_or_else(|e| panic!("{e}"));
+        let mut edit =
+            SceneEdit::from_toml_str(BEND, "bend.toml").unwrap_or_else(|e| panic!("{e}"));
         edit.walls[0].points[2] = edit.walls[0].points[1];
         let toml = edit.to_toml();
         let err = edit
@@ -318,18 +321,23 @@ mod tests {
             .map(|(i, _)| format!("edit.toml:{}: walls[0].points: ", i + 1))
             .collect();
         assert_eq!(lines.len(), 2, "{toml}");
-        assert!(lines.iter().any(|l| err.starts_with(l)), "{err} at none of {lines:?}");
+        assert!(
+            lines.iter().any(|l| err.starts_with(l)),
+            "{err} at none of {lines:?}"
+        );
         edit.walls[0].points[2] = [f64::INFINITY, 0.0];
         let err = edit.validate("edit.toml").err().map(|e| e.to_string());
         assert!(
-            err.as_deref().is_some_and(|e| e.contains("walls[0].points")),
+            err.as_deref()
+                .is_some_and(|e| e.contains("walls[0].points")),
             "{err:?}"
         );
     }
 
     #[test]
     fn too_many_points_are_refused_before_validation() {
-        let mut edit = SceneEdit::from_toml_str(BEND, "bend.toml").unwrap_or_else(|e| panic!("{e}"));
+        let mut edit =
+            SceneEdit::from_toml_str(BEND, "bend.toml").unwrap_or_else(|e| panic!("{e}"));
         edit.walls.push(WallEdit {
             kind: BoundaryKind::Rule,
             points: (0..MAX_EDIT_WALL_POINTS)

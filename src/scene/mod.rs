@@ -38,11 +38,11 @@
 //!
 //! [`geometry`]: crate::geometry
 
+pub mod edit;
 mod file;
 mod locate;
 pub mod shorthand;
 mod validate;
-pub mod edit;
 
 pub use crate::geometry::{BoundaryKind, FinishLine, FinishPoint, Wall};
 pub use edit::SceneEdit;

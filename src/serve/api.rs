@@ -50,9 +50,8 @@ pub struct CheckedEdit {
 /// Reads and validates the body of `POST /api/solve` without solving: a malformed body is a 400, a scene
 /// the validator refuses a 422 with its one-line error and key.
 pub fn check_edit(body: &[u8], time_limit: Duration) -> Result<CheckedEdit, Response> {
-    let request: SolveRequest = serde_json::from_slice(body).map_err(|e| {
-        Response::error(400, "bad-request", &format!("request body: {e}"))
-    })?;
+    let request: SolveRequest = serde_json::from_slice(body)
+        .map_err(|e| Response::error(400, "bad-request", &format!("request body: {e}")))?;
     let quality = match request.quality.as_str() {
         "fast" => Quality::Fast,
         "balanced" => Quality::Balanced,
@@ -65,7 +64,10 @@ pub fn check_edit(body: &[u8], time_limit: Duration) -> Result<CheckedEdit, Resp
             }))
         }
     };
-    let scene = request.scene.validate(EDIT_ORIGIN).map_err(|e| invalid(&e))?;
+    let scene = request
+        .scene
+        .validate(EDIT_ORIGIN)
+        .map_err(|e| invalid(&e))?;
     let settings = SearchSettings {
         time_limit: Some(time_limit),
         ..SearchSettings::for_quality(quality)
@@ -122,7 +124,9 @@ pub fn handle(app: &App, req: &Request, page: &'static str) -> Response {
             Err(e) => Response::error(500, "error", &e.to_string()),
         },
         ("POST", "/api/solve") => solve(app, req),
-        ("GET", path) if path.starts_with("/download/") => download(app, &path["/download/".len()..]),
+        ("GET", path) if path.starts_with("/download/") => {
+            download(app, &path["/download/".len()..])
+        }
         (_, "/" | "/index.html" | "/api/scene" | "/api/progress" | "/api/solve") => {
             Response::error(405, "bad-request", "method not allowed")
         }
@@ -131,10 +135,11 @@ pub fn handle(app: &App, req: &Request, page: &'static str) -> Response {
 }
 
 fn solve(app: &App, req: &Request) -> Response {
-    let is_json = req
-        .content_type
-        .as_deref()
-        .is_some_and(|t| t.split(';').next().is_some_and(|m| m.trim().eq_ignore_ascii_case("application/json")));
+    let is_json = req.content_type.as_deref().is_some_and(|t| {
+        t.split(';')
+            .next()
+            .is_some_and(|m| m.trim().eq_ignore_ascii_case("application/json"))
+    });
     if !is_json {
         return Response::error(415, "bad-request", "send the edit as application/json");
     }
@@ -173,7 +178,10 @@ fn summary(solved: &Solved) -> Value {
     );
     if let Some(map) = summary.as_object_mut() {
         map.remove("plans");
-        map.insert("scene_path".to_string(), json!(file_name(&solved.job.scene.name, "toml")));
+        map.insert(
+            "scene_path".to_string(),
+            json!(file_name(&solved.job.scene.name, "toml")),
+        );
     }
     summary
 }
@@ -209,9 +217,19 @@ fn file_name(name: &str, extension: &str) -> String {
     let stem: String = name
         .chars()
         .take(80)
-        .map(|c| if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
-    let stem = if stem.trim_matches('.').is_empty() { "scene".to_string() } else { stem };
+    let stem = if stem.trim_matches('.').is_empty() {
+        "scene".to_string()
+    } else {
+        stem
+    };
     format!("{stem}.{extension}")
 }
 
@@ -241,7 +259,13 @@ fn download(app: &App, what: &str) -> Response {
                 .with_run("greedy", &outcome.greedy)
                 .with_run("optimised", &outcome.trace);
             written(&|w| report::write_html(&input, w))
-                .map(|b| Response::download("text/html; charset=utf-8", &file_name(&scene.name, "html"), b))
+                .map(|b| {
+                    Response::download(
+                        "text/html; charset=utf-8",
+                        &file_name(&scene.name, "html"),
+                        b,
+                    )
+                })
                 .map_err(|e| e.to_string())
         }
         "plan.hltas" => report::hltas_script(&outcome.trace, &scene.vars, &scene.name)
@@ -261,7 +285,13 @@ fn download(app: &App, what: &str) -> Response {
                     b,
                 )
             }),
-        _ => return Response::error(404, "not-found", "downloads: scene.toml, plan.hltas, trajectory.csv, report.html"),
+        _ => {
+            return Response::error(
+                404,
+                "not-found",
+                "downloads: scene.toml, plan.hltas, trajectory.csv, report.html",
+            )
+        }
     };
     result.unwrap_or_else(|e| Response::error(422, "error", &e))
 }

@@ -114,10 +114,7 @@ pub fn read_request(stream: &mut TcpStream) -> Result<Request, ReadError> {
                 ))
             }
             Err(httparse::Error::TooManyHeaders) => {
-                return Err(refuse(
-                    431,
-                    &format!("more than {MAX_HEADERS} headers"),
-                ))
+                return Err(refuse(431, &format!("more than {MAX_HEADERS} headers")))
             }
             Err(e) => return Err(refuse(400, &format!("malformed request: {e}"))),
         }

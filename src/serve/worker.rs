@@ -187,10 +187,7 @@ impl Solver {
                         s.stage = "greedy baseline and lower bound".to_string();
                         break (id, job, cancel);
                     }
-                    s = self
-                        .changed
-                        .wait(s)
-                        .unwrap_or_else(|e| e.into_inner());
+                    s = self.changed.wait(s).unwrap_or_else(|e| e.into_inner());
                 }
             };
             let result = catch_unwind(AssertUnwindSafe(|| {
@@ -263,7 +260,9 @@ fn stage_text(p: &Progress) -> String {
         ),
         Progress::FrameCount { frames, reached } => format!(
             "trying {frames} frames: {}",
-            reached.map_or("not reached".to_string(), |r| format!("crosses in frame {r}"))
+            reached.map_or("not reached".to_string(), |r| format!(
+                "crosses in frame {r}"
+            ))
         ),
         Progress::Finishing => "rounding sides, polishing, checking in engine-exact mode".into(),
     }
