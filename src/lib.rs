@@ -16,6 +16,7 @@ pub mod optimise;
 pub mod physics;
 pub mod report;
 pub mod scene;
+pub mod serve;
 pub mod sim;
 
 pub use error::{Error, Result};

@@ -28,6 +28,8 @@ pub enum Command {
     Bench(super::bench::BenchArgs),
     /// Run every scene that carries an [expect] table and report whether a result got worse.
     Check(CheckArgs),
+    /// Serve the planner page on a local port: edit a corridor, see the optimal and greedy lines.
+    Serve(ServeArgs),
 }
 
 /// `strafeopt check [PATHS...]`
@@ -47,6 +49,25 @@ pub struct CheckArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub output: OutputFlags,
+}
+
+/// `strafeopt serve [SCENE] [--port N]`
+#[derive(Debug, Args)]
+pub struct ServeArgs {
+    /// The scene the page starts from (TOML; default: a 90-degree bend at 100 fps).
+    pub scene: Option<PathBuf>,
+    /// Port to listen on (0: any free port; the address is printed).
+    #[arg(long, default_value_t = 8377)]
+    pub port: u16,
+    /// Address to listen on instead of 127.0.0.1 (warns: anyone who can reach it can run solves).
+    #[arg(long)]
+    pub bind: Option<std::net::IpAddr>,
+    /// The quality the page starts with.
+    #[arg(long, value_enum, default_value_t = QualityArg::Fast)]
+    pub quality: QualityArg,
+    /// Stop each solve after this many seconds with the best valid plan so far.
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+    pub time_limit: f64,
 }
 
 /// Output files every run can write besides `--trajectory`.

@@ -9,6 +9,7 @@ pub mod calc;
 pub mod check;
 pub mod progress;
 pub mod report_cmd;
+pub mod serve;
 pub mod simulate;
 pub mod solve;
 
@@ -130,6 +131,7 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
         Command::Report(a) => report_cmd::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Check(a) => check::run(a).map(|(out, _)| out),
+        Command::Serve(a) => serve::run(a),
         Command::Calc(c) => {
             let figures = calc::run(&c.form)?;
             if calc::wants_json(&c.form) {

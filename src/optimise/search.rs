@@ -642,13 +642,25 @@ fn plan_jumping_scene(finisher: &Finisher, settings: &SearchSettings, budget: Bu
 
 /// Checks a time limit given in seconds.
 pub fn time_limit(seconds: f64) -> Result<Duration> {
-    if seconds.is_finite() && seconds > 0.0 {
-        Ok(Duration::from_secs_f64(seconds))
-    } else {
-        Err(Error::invalid(
+    match Duration::try_from_secs_f64(seconds) {
+        Ok(d) if seconds > 0.0 => Ok(d),
+        _ => Err(Error::invalid(
             "--time-limit",
             seconds,
-            "a finite number of seconds above 0",
-        ))
+            "a finite number of seconds above 0 and below about 1.8e19",
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_limits_out_of_range_are_errors_not_panics() {
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e300] {
+            assert!(time_limit(bad).is_err(), "{bad}");
+        }
+        assert_eq!(time_limit(2.5).ok(), Some(Duration::from_millis(2500)));
     }
 }

@@ -42,6 +42,7 @@
 //!
 //! [`geometry`]: crate::geometry
 
+pub mod edit;
 pub mod expect;
 mod file;
 mod locate;
@@ -49,6 +50,7 @@ pub mod shorthand;
 mod validate;
 
 pub use crate::geometry::{BoundaryKind, FinishLine, FinishPoint, Wall};
+pub use edit::SceneEdit;
 pub use expect::{expectation_from_str, Expectation, ExpectedRun, Limits};
 pub use file::{EngineFile, FinishFile, Point, SceneFile, StartFile, WallFile};
 pub(crate) use locate::one_line;
