@@ -3,6 +3,7 @@
 
 pub mod bound;
 pub mod hillclimb;
+pub mod hops;
 pub mod jumps;
 pub mod lagrangian;
 pub mod model;

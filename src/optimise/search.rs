@@ -124,10 +124,10 @@ pub enum SearchStatus {
     },
     /// The time limit stopped it; the best valid plan so far is returned.
     TimeLimit,
-    /// The scene uses effects the optimiser does not plan (ground, gravity, jumps): the greedy run is
-    /// returned.
-    GreedyOnly {
-        /// Which effects.
+    /// The greedy run is optimal: it crosses in the lower bound's frame, so no plan can cross earlier
+    /// (the greedy run is returned).
+    GreedyOptimal {
+        /// Why, with the frames.
         reason: String,
     },
     /// The optimiser found no valid plan better than the greedy one (which is returned).
@@ -146,7 +146,7 @@ impl std::fmt::Display for SearchStatus {
             SearchStatus::TimeLimit => {
                 f.write_str("stopped by the time limit with the best valid plan so far")
             }
-            SearchStatus::GreedyOnly { reason } => write!(f, "greedy plan returned: {reason}"),
+            SearchStatus::GreedyOptimal { reason } => write!(f, "greedy is optimal: {reason}"),
             SearchStatus::NoImprovement { reason } => write!(f, "greedy plan returned: {reason}"),
         }
     }
@@ -866,6 +866,17 @@ fn solve_once(
     // anglemod, and quantising them here could cost the frame that makes the plan no worse than greedy).
     let greedy_plan = (greedy.controls.clone(), greedy.clone());
     if !scene.effects.is_air_only() {
+        // Greedy already crossing in the bound's frame is optimal (the groundstrafe lane): say so.
+        let greedy_status = super::hops::greedy_status(&greedy_plan.1, &bound);
+        if matches!(greedy_status, SearchStatus::GreedyOptimal { .. }) {
+            return Ok(finish(
+                greedy_plan.0,
+                greedy_plan.1,
+                greedy_status,
+                stats,
+                "greedy",
+            ));
+        }
         // Jumping scenes with the Source boost: the policy search of `jumps` (issue 7). It keeps a plan
         // only if it is valid in f64 and engine-exact; greedy stays the answer when it is faster.
         if let Some(plan) = super::jumps::plan_jumps(&sim, settings, deadline) {
@@ -889,16 +900,33 @@ fn solve_once(
                 ));
             }
         }
+        // Ground, gravity and jumps without the boost (GoldSrc bunnyhops under the cap, groundstrafing,
+        // Half-Life 2 air strafing with jumps): the hop planner of `hops`, same rules.
+        if let Some(plan) = super::hops::plan_hops(&sim, &bound.path, &caps, settings, deadline) {
+            stats.iterations = plan.evaluations;
+            let t = plan.best.time();
+            if t < time_of(&greedy_plan.1) {
+                let status = if plan.timed_out {
+                    SearchStatus::TimeLimit
+                } else {
+                    SearchStatus::Converged {
+                        gap: (t - bound.crossing.time) / bound.crossing.time.max(f64::MIN_POSITIVE),
+                    }
+                };
+                let best = plan.best;
+                return Ok(finish(
+                    best.trace.controls.clone(),
+                    best.trace,
+                    status,
+                    stats,
+                    "optimised",
+                ));
+            }
+        }
         return Ok(finish(
             greedy_plan.0,
             greedy_plan.1,
-            SearchStatus::GreedyOnly {
-                reason: format!(
-                    "the optimiser plans airborne strafing and Source jump-boost runs only; this scene also \
-                     runs {}",
-                    scene.effects
-                ),
-            },
+            greedy_status,
             stats,
             "greedy",
         ));
