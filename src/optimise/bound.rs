@@ -109,10 +109,10 @@ impl SpeedBound {
     }
 
     /// The largest speed after a jump frame from any speed up to `speed`: the bunnyhop cap (section 10),
-    /// the Source boost (section 11)
-    /// adds at most `p |Fm| <= p Mx` below the cap `(1 + p) Mx` and `|v| - (1 + p) Mx` above it, with
-    /// `p = 0.1` and the keys cropped by `duck_multiplier` while ducked, `p <= 0.5` otherwise; then the
-    /// clamp and the air FME (the jump leaves the ground before friction, section 3).
+    /// then the Source boost (section 11), which adds at most `p |Fm| <= p Mx` below the cap `(1 + p) Mx`
+    /// and `|v| - (1 + p) Mx` above it, with `p = 0.1` and the keys cropped by `duck_multiplier` when
+    /// ducked (`ducked = Some(crop)`), `p = 0.5` standing (the frame step has no sprint); then the clamp
+    /// and the air FME (the jump leaves the ground before friction, section 3).
     fn jump_next(&self, speed: f64, ducked: Option<f64>) -> f64 {
         // The cap keeps speeds up to T and cuts faster ones below 1.105 M <= T: at most min(s, T).
         let speed = self.bhop_cap_speed.map_or(speed, |t| speed.min(t));
@@ -124,8 +124,8 @@ impl SpeedBound {
                 };
                 let cap = (1.0 + p) * mx;
                 let below = (speed + p * fm).min(cap.max(speed));
-                // Above the cap the addition is `cap - |v|`, whatever p: at most `|v| - 1.1 Mx`.
-                below.max(2.0 * speed - 1.1 * mx)
+                // Above the cap the addition is `cap - |v|`: the speed becomes at most `2|v| - cap`.
+                below.max(2.0 * speed - cap)
             }
             None => speed,
         };
