@@ -518,8 +518,8 @@ impl ScheduleSearch {
                     keep(0, self.play(st, speed, frame));
                 }
             }
-            for phase in 1..fronts.len() {
-                for st in &fronts[phase].0 {
+            for (phase, front) in fronts.iter().enumerate().skip(1) {
+                for st in &front.0 {
                     let speed = self.bound.air_next(st.speed);
                     keep(phase - 1, self.play(st, speed, frame));
                 }
