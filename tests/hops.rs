@@ -90,7 +90,7 @@ fn bunnyhop_lane_brakes_one_ground_frame_under_the_cap_and_nears_the_bound() {
     let o = solved(&scene, Quality::Fast);
     // Measured with `strafeopt solve scenarios/hl-bhop-cap-100fps.toml --quality fast --json`: greedy
     // takes 21.61 s (every landing over the cap, every jump cut); the schedule bound is 17.5447 s.
-    check_plan("hl-bhop-cap-100fps", &o, 1759, 17.584_070_157_960_63);
+    check_plan("hl-bhop-cap-100fps", &o, 1759, 17.581_768_511_802_16);
     assert_eq!(o.bound.crossing.frames, 1755);
     let g = o.greedy.crossing.map_or(0.0, |g| g.time);
     assert!(g > 21.6, "{g}");
@@ -123,9 +123,9 @@ fn bunnyhop_lane_brakes_one_ground_frame_under_the_cap_and_nears_the_bound() {
 fn bunnyhop_corners_and_the_half_life_2_bend_are_pinned() {
     // Measured with `strafeopt solve SCENE --quality fast --json`.
     for (name, frames, time_s) in [
-        ("hl-bhop-bend90-100fps", 388, 3.875_854_033_547_787),
-        ("hl-bhop-hairpin-100fps", 455, 4.546_578_156_542_604),
-        ("hl2-bend90-66fps", 338, 5.066_348_115_870_627),
+        ("hl-bhop-bend90-100fps", 387, 3.866_731_981_004_375_7),
+        ("hl-bhop-hairpin-100fps", 455, 4.543_280_784_029_232),
+        ("hl2-bend90-66fps", 320, 4.793_256_602_595_346_5),
     ] {
         let o = solved(&load(name), Quality::Fast);
         check_plan(name, &o, frames, time_s);

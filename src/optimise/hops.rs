@@ -32,6 +32,7 @@
 
 use super::bound::{bhop_cap_horizontal_speed, LowerBound};
 use super::search::{Quality, SearchSettings, SearchStatus};
+use crate::physics::closed_form::max_groundstrafe_speed;
 use crate::physics::engine_exact::quantise_yaw_rad;
 use crate::physics::strafe::{
     max_accel, max_decel, speed_preserving_cos_theta, strafe_control, strafe_keys, theta_from_cos,
@@ -330,7 +331,8 @@ impl HopSearch<'_, '_> {
 struct Grids {
     sweeps: u64,
     air_steps_ups: Vec<f64>,
-    takeoffs_ups: Vec<f64>,
+    /// Take-off speeds as shares of the groundstrafing top speed.
+    takeoff_shares: Vec<f64>,
     lookaheads_units: Vec<f64>,
 }
 
@@ -345,8 +347,8 @@ impl Grids {
         Grids {
             sweeps,
             air_steps_ups: (0..=n).map(|i| i as f64 * air_step).collect(),
-            takeoffs_ups: vec![
-                0.0, 300.0, 350.0, 400.0, 425.0, 450.0, 470.0, 480.0, 490.0, 495.0,
+            takeoff_shares: vec![
+                0.6, 0.7, 0.8, 0.85, 0.9, 0.93, 0.95, 0.97, 0.98, 0.99, 0.995,
             ],
             lookaheads_units: GREEDY_LOOKAHEADS_UNITS
                 .iter()
@@ -362,7 +364,8 @@ impl Grids {
 /// over [`HopPolicy`] from the best greedy policy (every look-ahead); `None` for scenes this planner does
 /// not cover (purely airborne, or with the Source boost: [`super::jumps`]) or when no candidate reaches
 /// the line validly. `corner_speeds_ups` are extra air speeds to try (the radius-speed relation's corner
-/// speeds).
+/// speeds). `balanced` and `exact` also run the levels below them, each its own descent from greedy
+/// (they end in different local optima), and keep the fastest plan: a higher level is never worse.
 pub fn plan_hops(
     sim: &Simulation,
     guide: &[Vec2],
@@ -370,24 +373,61 @@ pub fn plan_hops(
     settings: &SearchSettings,
     deadline: Option<Instant>,
 ) -> Option<HopPlan> {
-    let scene = sim.scene();
-    let fx = scene.effects;
+    let fx = sim.scene().effects;
     if fx.is_air_only() || fx.has(Effect::JumpBoost) {
         return None;
     }
-    let grids = Grids::for_quality(settings.quality);
-    let mut search = HopSearch {
-        sim,
-        guide,
-        best: None,
-        evaluations: 0,
-        deadline,
-        timed_out: false,
+    let levels: &[Quality] = match settings.quality {
+        Quality::Fast => &[Quality::Fast],
+        Quality::Balanced => &[Quality::Fast, Quality::Balanced],
+        Quality::Exact => &[Quality::Fast, Quality::Balanced, Quality::Exact],
     };
-    let start = HopPolicy::greedy(GREEDY_LOOKAHEADS_UNITS[GREEDY_LOOKAHEADS_UNITS.len() / 2]);
-    for &la in &GREEDY_LOOKAHEADS_UNITS {
-        search.try_policy(HopPolicy::greedy(la));
+    let mut plan: Option<HopPlan> = None;
+    for &level in levels {
+        let mut search = HopSearch {
+            sim,
+            guide,
+            best: None,
+            evaluations: 0,
+            deadline,
+            timed_out: false,
+        };
+        for &la in &GREEDY_LOOKAHEADS_UNITS {
+            search.try_policy(HopPolicy::greedy(la));
+        }
+        let sweeps = descend(&mut search, &Grids::for_quality(level), corner_speeds_ups);
+        let (evaluations, timed_out) = (search.evaluations, search.timed_out);
+        let before = plan.take();
+        let (mut total_evaluations, mut total_sweeps) = (evaluations, sweeps);
+        if let Some(p) = &before {
+            total_evaluations += p.evaluations;
+            total_sweeps += p.sweeps;
+        }
+        let timed_out = timed_out || before.as_ref().is_some_and(|p| p.timed_out);
+        let best = match (before.map(|p| p.best), search.best) {
+            (Some(a), Some(b)) => Some(if b.time() < a.time() { b } else { a }),
+            (a, b) => a.or(b),
+        };
+        plan = best.map(|best| HopPlan {
+            best,
+            evaluations: total_evaluations,
+            sweeps: total_sweeps,
+            timed_out,
+        });
+        if timed_out {
+            break;
+        }
     }
+    plan
+}
+
+/// One level's coordinate descent from the best policy so far: the air speed with and without the cut
+/// together, the take-off speed, the look-ahead and the duck, repeated until a sweep gains nothing or
+/// the level's sweeps are spent. Returns the sweeps run.
+fn descend(search: &mut HopSearch, grids: &Grids, corner_speeds_ups: &[f64]) -> u64 {
+    let scene = search.sim.scene();
+    let fx = scene.effects;
+    let start = HopPolicy::greedy(GREEDY_LOOKAHEADS_UNITS[GREEDY_LOOKAHEADS_UNITS.len() / 2]);
     // Air speeds: none, around the cap's uncut speed (from just under it up), and the corner speeds.
     let mut air_speeds: Vec<f64> = vec![f64::INFINITY];
     if fx.has(Effect::BhopCap) {
@@ -395,14 +435,19 @@ pub fn plan_hops(
         air_speeds.extend(grids.air_steps_ups.iter().map(|d| uncut + d));
     }
     air_speeds.extend(corner_speeds_ups.iter().copied());
-    let mut takeoffs = grids.takeoffs_ups.clone();
+    // Take-off speeds: at once, shares of the groundstrafing top speed (physics.md section 12; the
+    // ground FME gains fastest far below it), never.
+    let top = max_groundstrafe_speed(&scene.vars, fx.has(Effect::EdgeFriction));
+    let mut takeoffs = vec![0.0];
+    if top.is_finite() {
+        takeoffs.extend(grids.takeoff_shares.iter().map(|f| f * top));
+    }
     takeoffs.push(f64::INFINITY);
-    let jumps = fx.has(Effect::Jump);
     let mut sweeps = 0;
     loop {
         sweeps += 1;
         let before = search.best.as_ref().map_or(f64::INFINITY, |b| b.time());
-        if jumps {
+        if fx.has(Effect::Jump) {
             // The cap's choices together: the air speed with and without the cut.
             let base = search.best_policy(start);
             for avoid_cut in [true, false] {
@@ -436,21 +481,9 @@ pub fn plan_hops(
         }
         let after = search.best.as_ref().map_or(f64::INFINITY, |b| b.time());
         if after >= before || sweeps >= grids.sweeps || search.timed_out {
-            break;
+            return sweeps;
         }
     }
-    let HopSearch {
-        best,
-        evaluations,
-        timed_out,
-        ..
-    } = search;
-    best.map(|best| HopPlan {
-        best,
-        evaluations,
-        sweeps,
-        timed_out,
-    })
 }
 
 /// The status of a solve that returns the greedy run: [`SearchStatus::GreedyOptimal`] when greedy is
