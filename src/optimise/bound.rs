@@ -226,6 +226,17 @@ pub fn jump_schedule_time_to_cover(
     path_length: f64,
     progress: (Vec2, f64),
 ) -> Option<Crossing> {
+    let (search, first_ground) = schedule_search(scene, path_length, progress)?;
+    search.run(scene.start.speed(), first_ground, scene.max_frames)
+}
+
+/// The dynamic programme of [`jump_schedule_time_to_cover`] for `scene`, with the first frame that starts
+/// on the ground; `None` when the scene does not jump or never lands.
+fn schedule_search(
+    scene: &Scene,
+    path_length: f64,
+    progress: (Vec2, f64),
+) -> Option<(ScheduleSearch, u64)> {
     let (vars, fx) = (&scene.vars, scene.effects);
     if !(fx.has(Effect::Gravity) && fx.has(Effect::Jump)) {
         return None;
@@ -324,7 +335,7 @@ pub fn jump_schedule_time_to_cover(
         progress_units,
         along_cap,
     };
-    search.run(scene.start.speed(), first_ground, scene.max_frames)
+    Some((search, first_ground))
 }
 
 /// Frames [`jump_schedule_time_to_cover`] steps to find the first landing, the unduck frame and the
@@ -726,5 +737,113 @@ mod jump_schedule_tests {
             assert!(b.ground_next(s, law) <= s + 1e-9, "{s}");
         }
         assert!(b.ground_next(0.5 * s_star, law) > 0.5 * s_star);
+    }
+
+    /// Every jump schedule, enumerated without pruning or merging: the earliest crossing from a state
+    /// that starts frame `frame` in `phase` (0: on the ground, `k`: `k` air frames to the landing).
+    fn exhaustive(
+        search: &ScheduleSearch,
+        state: ScheduleState,
+        frame: u64,
+        phase: u64,
+        max_frames: u64,
+    ) -> Option<Crossing> {
+        if frame > max_frames {
+            return None;
+        }
+        let mut best: Option<Crossing> = None;
+        let mut follow = |speed: f64, next_phase: u64| {
+            let c = match search.play(&state, speed, frame) {
+                Err(c) => Some(c),
+                Ok(next) => exhaustive(search, next, frame + 1, next_phase, max_frames),
+            };
+            if let Some(c) = c {
+                if best.is_none_or(|b| c.time < b.time) {
+                    best = Some(c);
+                }
+            }
+        };
+        if phase > 0 {
+            follow(search.bound.air_next(state.speed), phase - 1);
+            return best;
+        }
+        let ducked = frame < search.standing_from;
+        follow(
+            search.bound.jump_next(state.speed, Some(search.crop)),
+            search.ducked_airtime - 1,
+        );
+        if !ducked {
+            follow(
+                search.bound.jump_next(state.speed, None),
+                search.standing_airtime - 1,
+            );
+        }
+        let law = if ducked {
+            search.ducked_law
+        } else {
+            search.standing_law
+        };
+        follow(search.bound.ground_next(state.speed, law), 0);
+        best
+    }
+
+    /// The dynamic programme (Pareto fronts, the jump-at-once prune, the cap's envelope) finds the same
+    /// earliest crossing as enumerating every schedule, on short GoldSrc bunnyhop lanes starting on the
+    /// ground below, near and above the cap's speed (so the cut, the prune and ground braking all occur).
+    #[test]
+    fn the_schedule_programme_equals_exhaustive_enumeration() {
+        for (speed, length) in [
+            (320.0, 700.0),
+            (540.0, 900.0),
+            (600.0, 1000.0),
+            (700.0, 1100.0),
+        ] {
+            let text = format!(
+                "name = \"t\"\n[engine]\npreset = \"goldsrc\"\nfps = 100\neffects = [\"air-accel\", \
+                 \"ground-accel\", \"friction\", \"gravity\", \"jump\", \"bhop-cap\", \"max-velocity\"]\n\
+                 [start]\non-ground = true\nvelocity = [{speed}, 0]\n[lane]\nwidth = 256\nlength = {length}\n\
+                 kind = \"rule\"\n"
+            );
+            let scene = Scene::from_toml_str(&text, "t.toml").unwrap_or_else(|e| panic!("{e}"));
+            let distance = length - 40.0;
+            let progress = (Vec2::new(1.0, 0.0), distance);
+            let (search, first_ground) =
+                schedule_search(&scene, distance, progress).unwrap_or_else(|| panic!("a search"));
+            assert_eq!(first_ground, 1);
+            let dp = search.run(speed, first_ground, scene.max_frames);
+            let start = ScheduleState {
+                speed,
+                covered: 0.0,
+                covered_along: 0.0,
+            };
+            let all = exhaustive(&search, start, 1, 0, 400);
+            assert!(dp.is_some(), "{speed}");
+            assert_eq!(dp, all, "start {speed} ups, {distance} units");
+        }
+        // Half-Life 2 with the boost, a ducked start at rest: both jump kinds and their airtimes (35
+        // ticks standing, 36 ducked), the unduck frames.
+        for length in [300.0, 450.0] {
+            let text = format!(
+                "name = \"t\"\n[engine]\npreset = \"source-hl2\"\nfps = 66.666666666666667\nmaxspeed = 150\n\
+                 effects = [\"air-accel\", \"ground-accel\", \"friction\", \"gravity\", \"jump\", \
+                 \"jump-boost\", \"duck\", \"max-velocity\"]\n[start]\nvelocity = [0, 0]\non-ground = true\n\
+                 ducked = true\n[lane]\nwidth = 64\nlength = {length}\nkind = \"rule\"\n"
+            );
+            let scene = Scene::from_toml_str(&text, "t.toml").unwrap_or_else(|e| panic!("{e}"));
+            let distance = length - 40.0;
+            let (search, first_ground) =
+                schedule_search(&scene, distance, (Vec2::new(1.0, 0.0), distance))
+                    .unwrap_or_else(|| panic!("a search"));
+            assert_eq!((search.standing_airtime, search.ducked_airtime), (35, 36));
+            let dp = search.run(0.0, first_ground, scene.max_frames);
+            let start = ScheduleState {
+                speed: 0.0,
+                covered: 0.0,
+                covered_along: 0.0,
+            };
+            let all = exhaustive(&search, start, first_ground, 0, 200);
+            assert!(dp.is_some(), "{length}");
+            assert_eq!(dp, all, "{length} units");
+        }
     }
 }
