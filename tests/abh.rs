@@ -28,7 +28,8 @@ fn run(params: AbhParams) -> AbhRun {
 /// The run re-derived in one dimension from docs/physics.md alone (no `Stepper`): the unduck frames, ground
 /// friction (section 4) and the ground FME along the velocity (section 5) while walking, the boost
 /// (section 11) on jump frames, the per-component clamp (section 10), and the discrete airtime of the jump
-/// (section 3: the jump speed replaces the first half-step, landing within the 2-unit layer).
+/// (sections 2 and 3: ducked, the jump sets `v_z = 160`; standing, it adds 160 to the first gravity
+/// half-step; the player lands within the 2-unit layer).
 struct Expected {
     jump_frames: Vec<u64>,
     speeds: Vec<f64>,
@@ -42,11 +43,14 @@ fn expected(walk_while_unducking: bool) -> Expected {
     let (mx, k, e) = (v.maxspeed, v.friction_k(false), v.stopspeed);
     // Unduck: standing once the timer reaches 0.2 s, in the frame it does.
     let unduck_frames = ((v.unduck_time_s / tau) - 1e-9).ceil() as u64;
-    // Discrete airtime: z(n) = tau (n v0 - g tau n (n - 1) / 2); the player lands after frame n when
-    // z(n) <= 2 and jumps again in frame n + 1.
-    let v0 = (2.0 * v.gravity * 21.0).sqrt();
-    let z = |n: f64| tau * (n * v0 - v.gravity * tau * n * (n - 1.0) / 2.0);
-    let air_frames = (2..1000).find(|&n| z(n as f64) <= 2.0).unwrap_or(0) as u64;
+    // Discrete airtime: with v0 the vertical speed of the jump frame's move, z(n) = tau (n v0 - g tau
+    // n (n - 1) / 2); the player lands after frame n when z(n) <= 2 and jumps again in frame n + 1.
+    let air_frames_of = |v0: f64| {
+        let z = |n: f64| tau * (n * v0 - v.gravity * tau * n * (n - 1.0) / 2.0);
+        (2..1000).find(|&n| z(n as f64) <= 2.0).unwrap_or(0) as u64
+    };
+    let standing_air_frames = air_frames_of(160.0 - v.gravity * tau / 2.0);
+    let ducked_air_frames = air_frames_of(160.0);
     let (mut x, mut speed) = (0.0_f64, 0.0_f64);
     let mut jump_frames = Vec::new();
     let mut speeds = Vec::new();
@@ -59,7 +63,7 @@ fn expected(walk_while_unducking: bool) -> Expected {
                 speed = boosted_speed(speed, mx, 0.5, mx, false).min(v.maxvelocity);
                 jump_frames.push(frame);
                 speeds.push(speed);
-                next_jump = Some(frame + air_frames);
+                next_jump = Some(frame + standing_air_frames);
             } else {
                 // Friction, then the ground FME straight ahead with wish speed M (cropped while ducked).
                 if speed >= 0.1 {
@@ -85,7 +89,7 @@ fn expected(walk_while_unducking: bool) -> Expected {
             speed = boosted_speed(speed, 0.0, 0.1, mx, true).min(v.maxvelocity);
             jump_frames.push(frame);
             speeds.push(speed);
-            next_jump = Some(frame + air_frames);
+            next_jump = Some(frame + ducked_air_frames);
         }
         x += speed * tau;
         if x >= DISTANCE_UNITS {
@@ -103,17 +107,23 @@ fn expected(walk_while_unducking: bool) -> Expected {
 #[test]
 fn jump_speed_airtime_and_clamp_follow_physics_md() {
     let v = scene().vars;
-    // Section 2: sqrt(2 * 600 * 21) = 158.745 ups.
-    assert!((v.jump_speed_ups() - 158.745_078_663_875_43).abs() < 1e-9);
-    // Section 10's airtime back to the 2-unit layer with Source's numbers: 0.5163 s, 34.4 frames; the
-    // frame loop lands 36 frames after the jump (0.54 s), not the article's 0.51 s.
+    // Section 2: Half-Life 2's fixed 160 ups (movement optimisations on), not sqrt(2 * 600 * 21).
+    assert_eq!(v.jump_speed_ups(), 160.0);
+    assert_eq!(v.jump_vz_ups(-4.5, true), 160.0);
+    assert_eq!(v.jump_vz_ups(-4.5, false), 155.5);
+    // Section 10's airtime back to the 2-unit layer with Source's numbers: (160 + sqrt(160^2 - 4 g)) / g
+    // = 0.5205 s, 34.7 frames; the frame loop lands 36 frames after a ducked jump (0.54 s) and 35 after
+    // the standing first jump (0.525 s, 4.5 ups slower up), not the article's 0.51 s.
     let t = jump_airtime_s(&v).unwrap_or(f64::NAN);
-    assert!((t - 0.516_31).abs() < 1e-4, "{t}");
+    assert!((t - 0.520_53).abs() < 1e-4, "{t}");
     let r = run(AbhParams::default());
-    for h in &r.hops[..r.hops.len() - 1] {
-        assert_eq!(h.hop_time.map(|t| (t / 0.015).round() as u64), Some(36));
-        assert!((h.hop_time.unwrap_or(0.0) - 0.54).abs() < 1e-12);
-    }
+    let frames: Vec<Option<u64>> = r.hops[..r.hops.len() - 1]
+        .iter()
+        .map(|h| h.hop_time.map(|t| (t / 0.015).round() as u64))
+        .collect();
+    assert_eq!(frames[0], Some(35));
+    assert!(frames[1..].iter().all(|&f| f == Some(36)), "{frames:?}");
+    assert!((r.hops[1].hop_time.unwrap_or(0.0) - 0.54).abs() < 1e-12);
     // Section 10/11: 2 * 2085 - 165 = 4005 is clamped per component to 3500 (the run is along x).
     let h7 = r.hops[6];
     assert!((boosted_speed(2085.0, 0.0, 0.1, 150.0, true) - 4005.0).abs() < 1e-9);
@@ -127,9 +137,9 @@ fn frame_level_run_matches_the_independent_derivation() {
     let r = run(AbhParams::default());
     let want = expected(false);
     let frames: Vec<u64> = r.hops.iter().map(|h| h.frame).collect();
-    // 14 unduck frames (the 14th already standing), 9 walking frames to 150 ups, the jump in frame 23;
-    // then one jump every 36 frames.
-    assert_eq!(frames, vec![23, 59, 95, 131, 167, 203, 239, 275]);
+    // 14 unduck frames (the 14th already standing), 9 walking frames to 150 ups, the standing jump in
+    // frame 23 (35 frames in the air); then a ducked backhop every 36 frames.
+    assert_eq!(frames, vec![23, 58, 94, 130, 166, 202, 238, 274]);
     assert_eq!(frames, want.jump_frames);
     for (h, s) in r.hops.iter().zip(&want.speeds) {
         assert!((h.speed - s).abs() < 1e-6, "{} vs {s}", h.speed);
@@ -144,7 +154,7 @@ fn frame_level_run_matches_the_independent_derivation() {
     let takeoff = r.trace.frames[j - 2].speed;
     assert!((takeoff - 150.0).abs() < 1e-6);
     assert!((r.hops[0].speed - boosted_speed(takeoff, 150.0, 0.5, 150.0, false)).abs() < 1e-9);
-    // Times from the pistol: first jump 22 * 0.015 = 0.330 s; the line at 4.330 s (the independent
+    // Times from the pistol: first jump 22 * 0.015 = 0.330 s; the line at 4.316 s (the independent
     // derivation to 1e-6 s; the pinned figure to 1 ms).
     assert!((r.first_jump.unwrap_or(f64::NAN) - 0.33).abs() < 1e-12);
     let t = r.pistol_to_line.unwrap_or(f64::NAN);
@@ -153,9 +163,9 @@ fn frame_level_run_matches_the_independent_derivation() {
         "{t} vs {}",
         want.crossing_time
     );
-    assert!((t - 4.330).abs() < 1e-3, "{t}");
-    // 4.000 s after the first jump, against the article's 3.865 s.
-    assert!((t - r.first_jump.unwrap_or(0.0) - 4.0).abs() < 1e-3);
+    assert!((t - 4.316).abs() < 1e-3, "{t}");
+    // 3.986 s after the first jump, against the article's 3.865 s.
+    assert!((t - r.first_jump.unwrap_or(0.0) - 3.986).abs() < 1e-3);
 }
 
 #[test]
@@ -288,9 +298,9 @@ fn cli_simulate_controller_abh() {
     let v = strafeopt(&["simulate", SCENE, "--controller", "abh", "--json"]);
     assert_eq!(v["controller"], "abh");
     assert_eq!(v["feasible"], true);
-    assert_eq!(v["frames"], 289);
+    assert_eq!(v["frames"], 288);
     let t = v["time"].as_f64().unwrap_or(f64::NAN);
-    assert!((t - 4.330).abs() < 1e-3, "{t}");
+    assert!((t - 4.316).abs() < 1e-3, "{t}");
     assert_eq!(v["first_rule_violation_frame"], Value::Null);
 }
 
@@ -319,7 +329,7 @@ fn cli_calc_abh_json_has_frame_level() {
         assert!(h["time"].is_f64() && h["speed"].is_f64(), "{h}");
     }
     assert!((hops[1]["speed"].as_f64().unwrap_or(0.0) - 285.0).abs() < 1e-6);
-    assert!((fl["pistol_to_line"].as_f64().unwrap_or(0.0) - 4.330).abs() < 1e-3);
+    assert!((fl["pistol_to_line"].as_f64().unwrap_or(0.0) - 4.316).abs() < 1e-3);
     assert!((fl["first_jump"].as_f64().unwrap_or(0.0) - 0.330).abs() < 1e-9);
     assert_eq!(fl["in_lane"], true);
     assert_eq!(fl["engine_exact"]["feasible"], true);

@@ -16,14 +16,14 @@ fn load(name: &str) -> Scene {
 
 /// (scene, greedy frames, greedy time s, greedy valid, bound frames, bound time s), measured with
 /// `strafeopt simulate SCENE --json`.
-const PINNED: [(&str, u64, f64, bool, u64, f64); 8] = [
+const PINNED: [(&str, u64, f64, bool, u64, f64); 11] = [
     (
         "hl-bend90-1000fps-aa100",
         3188,
-        3.187727247853926,
+        3.1877272478539265,
         true,
         3169,
-        3.168084665180256,
+        3.1680846651802557,
     ),
     (
         "hl-bend90-100fps",
@@ -42,12 +42,28 @@ const PINNED: [(&str, u64, f64, bool, u64, f64); 8] = [
         4.999689318900755,
     ),
     (
+        "hl-bhop-bend90-100fps",
+        459,
+        4.586892838761801,
+        true,
+        377,
+        3.7611453857915844,
+    ),
+    (
         "hl-bhop-cap-100fps",
         2161,
         21.60976962007521,
         true,
-        1186,
-        11.854959149644776,
+        1755,
+        17.544652677942764,
+    ),
+    (
+        "hl-bhop-hairpin-100fps",
+        536,
+        5.351822053302249,
+        false,
+        405,
+        4.043329738964877,
     ),
     (
         "hl-groundstrafe-1000fps",
@@ -75,11 +91,19 @@ const PINNED: [(&str, u64, f64, bool, u64, f64); 8] = [
     ),
     (
         "hl2-abh-100m",
-        632,
-        9.472848842316408,
+        737,
+        11.05453621493537,
         true,
         247,
-        3.7044267837154274,
+        3.6967325643592135,
+    ),
+    (
+        "hl2-bend90-66fps",
+        338,
+        5.065711647099607,
+        false,
+        313,
+        4.6840258444292076,
     ),
 ];
 

@@ -180,23 +180,6 @@ fn a_tiny_time_limit_ends_with_a_valid_plan_and_says_so() {
     assert!(t <= g + 1e-3, "{t} vs greedy {g}");
 }
 
-#[test]
-fn scenes_beyond_airstrafing_return_the_greedy_run() {
-    let scene = load("hl-bhop-cap-100fps");
-    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
-        .unwrap_or_else(|e| panic!("{e}"));
-    assert!(
-        matches!(o.status, SearchStatus::GreedyOnly { .. }),
-        "{:?}",
-        o.status
-    );
-    assert_eq!(o.source, "greedy");
-    assert!(o.trace.feasible());
-    // The greedy run itself is the plan: never worse than greedy.
-    assert_eq!(o.trace.crossing, o.greedy.crossing);
-    assert_eq!(o.controls, o.greedy.controls);
-}
-
 /// A 90-degree bend at 100 fps with Half-Life defaults, `width` units wide, legs `leg` units long, with
 /// `kind` walls.
 fn bend(width: f64, leg: f64, kind: &str) -> Scene {

@@ -445,7 +445,7 @@ pub fn status_name(status: &SearchStatus) -> &'static str {
         SearchStatus::Converged { .. } => "converged",
         SearchStatus::TimeLimit { .. } => "time-limit",
         SearchStatus::Cancelled { .. } => "cancelled",
-        SearchStatus::GreedyOnly { .. } => "greedy-only",
+        SearchStatus::GreedyOptimal { .. } => "greedy-optimal",
         SearchStatus::NoImprovement { .. } => "no-improvement",
     }
 }

@@ -96,7 +96,7 @@ impl Baseline {
 /// Speed caps from the radius-speed relation (docs/physics.md section 9): the speeds whose measured turn
 /// radius fits the largest arc through bends of [`CAP_WIDTHS_UNITS`] for the hull centre. Capped greedy
 /// runs seed corner lines the uncapped strafer overshoots.
-fn corner_caps(scene: &Scene) -> Vec<f64> {
+pub(super) fn corner_caps(scene: &Scene) -> Vec<f64> {
     CAP_WIDTHS_UNITS
         .iter()
         .filter_map(|&w| speed_for_radius(&scene.vars, bend_arc_radius(w)).ok())

@@ -12,6 +12,7 @@ use crate::budget::{Budget, Stage};
 use crate::error::{Error, Result};
 use crate::geometry::{Corridor, FinishPoint, HULL_HALF_WIDTH_UNITS};
 use crate::physics::strafe::max_accel;
+use crate::physics::vars::BHOP_CAP_FACTOR;
 use crate::physics::{
     AccelLaw, Effect, Effects, Game, MovementVars, PlayerState, Stepper, Vec2, Wish,
 };
@@ -30,6 +31,8 @@ pub struct SpeedBound {
     clamp_speed: Option<f64>,
     /// `Mx` when the Source jump boost can fire (docs/physics.md section 11).
     jump_boost_maxspeed: Option<f64>,
+    /// With the bunnyhop cap (docs/physics.md section 10), the largest horizontal speed a jump keeps uncut, ups.
+    bhop_cap_speed: Option<f64>,
 }
 
 impl SpeedBound {
@@ -56,12 +59,16 @@ impl SpeedBound {
             .has(Effect::MaxVelocity)
             .then_some(vars.maxvelocity * std::f64::consts::SQRT_2);
         let jump_boost_maxspeed = effects.has(Effect::JumpBoost).then_some(vars.maxspeed);
+        let bhop_cap_speed = effects
+            .has(Effect::BhopCap)
+            .then(|| bhop_cap_horizontal_speed(vars, effects));
         SpeedBound {
             air,
             ground,
             friction,
             clamp_speed,
             jump_boost_maxspeed,
+            bhop_cap_speed,
         }
     }
 
@@ -102,11 +109,14 @@ impl SpeedBound {
         law.map_or(l, |law| l.max(max_accel(l, law).speed))
     }
 
-    /// The largest speed after a jump frame from any speed up to `speed`: the Source boost (section 11)
-    /// adds at most `p |Fm| <= p Mx` below the cap `(1 + p) Mx` and `|v| - (1 + p) Mx` above it, with
-    /// `p = 0.1` and the keys cropped by `duck_multiplier` while ducked, `p <= 0.5` otherwise; then the
-    /// clamp and the air FME (the jump leaves the ground before friction, section 3).
+    /// The largest speed after a jump frame from any speed up to `speed`: the bunnyhop cap (section 10),
+    /// then the Source boost (section 11), which adds at most `p |Fm| <= p Mx` below the cap `(1 + p) Mx`
+    /// and `|v| - (1 + p) Mx` above it, with `p = 0.1` and the keys cropped by `duck_multiplier` when
+    /// ducked (`ducked = Some(crop)`), `p = 0.5` standing (the frame step has no sprint); then the clamp
+    /// and the air FME (the jump leaves the ground before friction, section 3).
     fn jump_next(&self, speed: f64, ducked: Option<f64>) -> f64 {
+        // The cap keeps speeds up to T and cuts faster ones below 1.105 M <= T: at most min(s, T).
+        let speed = self.bhop_cap_speed.map_or(speed, |t| speed.min(t));
         let boosted = match self.jump_boost_maxspeed {
             Some(mx) => {
                 let (p, fm) = match ducked {
@@ -115,8 +125,8 @@ impl SpeedBound {
                 };
                 let cap = (1.0 + p) * mx;
                 let below = (speed + p * fm).min(cap.max(speed));
-                // Above the cap the addition is `cap - |v|`, whatever p: at most `|v| - 1.1 Mx`.
-                below.max(2.0 * speed - 1.1 * mx)
+                // Above the cap the addition is `cap - |v|`: the speed becomes at most `2|v| - cap`.
+                below.max(2.0 * speed - cap)
             }
             None => speed,
         };
@@ -135,6 +145,19 @@ impl SpeedBound {
             }
         }
     }
+}
+
+/// The largest horizontal speed a jump from the flat floor keeps under the bunnyhop cap (docs/physics.md
+/// section 10), ups: the cap measures the 3-D speed after the first gravity half-step, `v_z = -g tau / 2`,
+/// so it is `sqrt((1.7 M)^2 - v_z^2)`. Faster jumps are cut to `1.105 M` in 3-D.
+pub fn bhop_cap_horizontal_speed(vars: &MovementVars, effects: Effects) -> f64 {
+    let cap = BHOP_CAP_FACTOR * vars.maxspeed;
+    let vz = if effects.has(Effect::Gravity) {
+        0.5 * vars.gravity * vars.frame_time_s()
+    } else {
+        0.0
+    };
+    (cap * cap - vz * vz).max(0.0).sqrt()
 }
 
 /// The time the greedy speed profile from `start` needs to cover `distance` units: the frame in which the
@@ -192,14 +215,19 @@ fn time_to_cover_within(
     Ok(None)
 }
 
-/// The schedule-aware bound of a scene with gravity, jumps and the Source jump boost (docs/physics.md
-/// sections 3, 10, 11), far tighter than [`time_to_cover`]'s profile, which lets the boost fire on any
-/// frame. It uses what the flat floor fixes whatever the controls:
+/// The schedule-aware bound of a scene with gravity and jumps (docs/physics.md sections 3, 4, 10, 11), far
+/// tighter than [`time_to_cover`]'s profile, which lets a jump (and its boost) fire on any frame and
+/// ignores the bunnyhop cap. It uses what the flat floor fixes whatever the controls:
 /// - the vertical motion depends on the jump frames only (gravity, the jump speed, the 2-unit ground
 ///   layer), so after a jump in frame `j` the player is airborne until frame `j + K` starts, `K` measured
-///   with the scene's own stepper; a jump needs a frame that starts on the ground;
+///   with the scene's own stepper; in Source a ducked jump sets `v_z = 160` and a standing one adds 160 to
+///   the first gravity half-step (section 2), so both airtimes are allowed; a jump needs a frame that
+///   starts on the ground;
 /// - an airborne frame runs only the air FME, a ground frame without a jump friction and the ground FME,
-///   a jump frame the boost and the air FME (the jump comes before friction, section 3);
+///   a jump frame the bunnyhop cap, the Source boost and the air FME (the jump comes before friction);
+/// - the bunnyhop cap (section 10) scales a jump's 3-D speed above `1.7 M` to `1.105 M`: whatever the
+///   speed `s` on the ground, the jump leaves at most `min(s, T)` horizontally, `T` the largest uncut
+///   horizontal speed with the frame's `v_z = -g tau / 2`;
 /// - from a ducked start the duck step keeps the player ducked until the unduck timer runs out (frame
 ///   `U`, also measured): before it the ground wish speed is cropped and the boost has `p = 0.1`;
 /// - `sv_maxvelocity` clamps each component before the FME (section 10), so the progress along the unit
@@ -208,16 +236,19 @@ fn time_to_cover_within(
 /// A jump schedule fixes which frames are ground, air and jump frames, so with the largest speed of each
 /// kind of frame (every step increasing in the speed) it gives the largest speed in every frame, hence the
 /// earliest frame that schedule could cover `path_length` along the path and `progress.1` units along
-/// `n = progress.0` (the later of the two). The bound is the earliest over all schedules, found by
-/// branch and bound: the search prunes schedules already past the best crossing and uses one dominance,
-/// **jump on the landing frame once the speed is at least the ground's fixed point `s*`**: above `s*` a
-/// ground frame cannot raise the speed (`G(s) <= s`), so delaying a jump by `d` frames gives speeds no
-/// higher, frame by frame, than jumping at once (the delayed run is at most the prompt run shifted `d`
-/// frames later, and the prompt run's speed never falls). After frame `U` the steps do not depend on the
-/// frame, which the shift needs, so below `U` every choice is branched on.
+/// `n = progress.0` (the later of the two). The bound is the earliest over all schedules, found by dynamic
+/// programming over frames: the state of a schedule in a frame is its phase (on the ground, or airborne
+/// with `k` frames to the next landing) and its speed and both distances so far; of two states in the same
+/// frame and phase, one at least as fast and as far along in both distances does at least as well in every
+/// later frame (the steps are monotone and depend on the frame only through `U`), so only the Pareto front
+/// of each phase is kept. One more dominance prunes: **jump on the landing frame once the speed is at least
+/// the ground's fixed point `s*` (and at most `T` under the cap)**: above `s*` a ground frame cannot raise
+/// the speed (`G(s) <= s`), and below `T` a jump keeps it, so a delayed jump is a prompt one shifted later
+/// with no higher speeds. After frame `U` the steps do not depend on the frame, which the shift needs, so
+/// before `U` every choice is kept.
 ///
-/// `None` when the scene does not jump with the boost or no schedule gets there within `max_frames`
-/// (or within the search's step budget); [`lower_bound`] then falls back to [`time_to_cover`].
+/// `None` when the scene does not jump, or no schedule gets there within `max_frames`; [`lower_bound`]
+/// then falls back to [`time_to_cover`].
 pub fn jump_schedule_time_to_cover(
     scene: &Scene,
     path_length: f64,
@@ -226,7 +257,7 @@ pub fn jump_schedule_time_to_cover(
     jump_schedule_time_to_cover_within(scene, path_length, progress, &Budget::unlimited())
 }
 
-/// [`jump_schedule_time_to_cover`] within `budget`: a search cut short proves nothing about the
+/// [`jump_schedule_time_to_cover`] within `budget`: a programme cut short proves nothing about the
 /// schedules it did not reach, so it gives `None` (and [`lower_bound_within`] the looser profile).
 pub fn jump_schedule_time_to_cover_within(
     scene: &Scene,
@@ -234,8 +265,19 @@ pub fn jump_schedule_time_to_cover_within(
     progress: (Vec2, f64),
     budget: &Budget,
 ) -> Option<Crossing> {
+    let (search, first_ground) = schedule_search(scene, path_length, progress)?;
+    search.run(scene.start.speed(), first_ground, scene.max_frames, budget)
+}
+
+/// The dynamic programme of [`jump_schedule_time_to_cover`] for `scene`, with the first frame that starts
+/// on the ground; `None` when the scene does not jump or never lands.
+fn schedule_search(
+    scene: &Scene,
+    path_length: f64,
+    progress: (Vec2, f64),
+) -> Option<(ScheduleSearch, u64)> {
     let (vars, fx) = (&scene.vars, scene.effects);
-    if !(fx.has(Effect::Gravity) && fx.has(Effect::Jump) && fx.has(Effect::JumpBoost)) {
+    if !(fx.has(Effect::Gravity) && fx.has(Effect::Jump)) {
         return None;
     }
     let tau = vars.frame_time_s();
@@ -264,18 +306,37 @@ pub fn jump_schedule_time_to_cover_within(
     }
     let first_ground = first_ground?;
     let standing_from = standing_from.unwrap_or(u64::MAX);
-    // The airtime K: frames from a jump frame to the next frame that starts on the ground.
-    let mut s = PlayerState::on_ground(Vec2::ZERO, Vec2::ZERO);
-    let jump = Wish { jump: true, ..idle };
-    stepper.step(&mut s, &jump);
-    let mut airtime = 1u64;
-    while !s.on_ground {
-        if airtime >= probe_frames {
-            return None;
+    // The airtimes: frames from a jump frame to the next frame that starts on the ground, standing and
+    // (with the duck effect) ducked.
+    let airtime_of = |ducked: bool| -> Option<u64> {
+        let mut s = PlayerState::on_ground(Vec2::ZERO, Vec2::ZERO);
+        s.ducked = ducked;
+        let jump = Wish {
+            jump: true,
+            duck: ducked,
+            ..idle
+        };
+        let hold = Wish {
+            duck: ducked,
+            ..idle
+        };
+        stepper.step(&mut s, &jump);
+        let mut airtime = 1u64;
+        while !s.on_ground {
+            if airtime >= probe_frames {
+                return None;
+            }
+            stepper.step(&mut s, &hold);
+            airtime += 1;
         }
-        stepper.step(&mut s, &idle);
-        airtime += 1;
-    }
+        Some(airtime)
+    };
+    let standing_airtime = airtime_of(false)?;
+    let ducked_airtime = if fx.has(Effect::Duck) {
+        airtime_of(true)?
+    } else {
+        standing_airtime
+    };
     let m = vars
         .maxspeed
         .min(vars.forward_key_speed.hypot(vars.side_key_speed));
@@ -299,52 +360,32 @@ pub fn jump_schedule_time_to_cover_within(
     };
     let bound = SpeedBound::new(vars, fx);
     let standing_law = law(m);
-    let mut search = ScheduleSearch {
+    let search = ScheduleSearch {
         bound,
         tau,
-        airtime,
+        standing_airtime,
+        ducked_airtime,
         standing_from,
         standing_law,
         ducked_law: law(m_ducked),
         crop,
         ground_fixed_point: ground_fixed_point(&bound, standing_law),
-        along_cap,
         path_length,
         progress_units,
-        max_frames: scene.max_frames,
-        best: None,
-        steps: 0,
-        budget: *budget,
-        stopped: false,
+        along_cap,
     };
-    let mut run = ScheduleRun {
-        frames: 0,
-        covered: 0.0,
-        covered_along: 0.0,
-        path_done: None,
-        along_done: None,
-    };
-    // Falling towards the first landing: air frames.
-    let mut speed = scene.start.speed();
-    for _ in 1..first_ground {
-        speed = bound.air_next(speed);
-        if search.play(&mut run, speed) {
-            return search.best;
-        }
-    }
-    search.ground_phase(run, speed);
-    if search.steps > MAX_SCHEDULE_SEARCH_STEPS || search.stopped {
-        return None;
-    }
-    search.best
+    Some((search, first_ground))
 }
 
 /// Frames [`jump_schedule_time_to_cover`] steps to find the first landing, the unduck frame and the
 /// airtime (far beyond any jump: 10 minutes at 100 fps).
 const MAX_SCHEDULE_PROBE_FRAMES: u64 = 60_000;
-/// Frames the schedule search may play in all before it gives up (its bound would still be valid, but
-/// perhaps not the earliest over all schedules).
-const MAX_SCHEDULE_SEARCH_STEPS: u64 = 50_000_000;
+/// Most states kept per phase and frame: beyond it the two nearest in speed are merged into one with the
+/// larger of each coordinate, which no schedule can beat (the bound stays valid, a little looser).
+const MAX_FRONT_STATES: usize = 64;
+
+/// Frames of the schedule programme between two looks at the budget.
+const SCHEDULE_FRAMES_PER_BUDGET_CHECK: u64 = 256;
 
 /// The fixed point `s*` of the standing ground step `G` (friction, then maximum ground acceleration): the
 /// limit of `G` iterated from rest. `G` is increasing, so it climbs to `s*`, and above `s*` the friction
@@ -364,130 +405,193 @@ fn ground_fixed_point(bound: &SpeedBound, law: Option<AccelLaw>) -> f64 {
 /// Iterations of [`ground_fixed_point`] (the ground speed converges geometrically, by `1 - tau k` a frame).
 const MAX_FIXED_POINT_ITERS: usize = 1_000_000;
 
-/// A partial schedule's distance so far.
-#[derive(Clone, Copy, Debug)]
-struct ScheduleRun {
-    frames: u64,
+/// One schedule's state after a frame: its speed bound and both distances, each held at its target once
+/// reached (past the target only the crossing frame matters, found when it is reached).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ScheduleState {
+    speed: f64,
     covered: f64,
     covered_along: f64,
-    path_done: Option<Crossing>,
-    along_done: Option<Crossing>,
 }
 
-/// The branch-and-bound search of [`jump_schedule_time_to_cover`].
-struct ScheduleSearch<'c> {
+impl ScheduleState {
+    /// At least as fast and as far along in both distances as `other`.
+    fn dominates(&self, other: &ScheduleState) -> bool {
+        self.speed >= other.speed
+            && self.covered >= other.covered
+            && self.covered_along >= other.covered_along
+    }
+}
+
+/// The Pareto front of one phase in one frame.
+#[derive(Clone, Debug, Default)]
+struct Front(Vec<ScheduleState>);
+
+impl Front {
+    /// Adds `state` unless a kept state dominates it, dropping the states it dominates.
+    fn insert(&mut self, state: ScheduleState) {
+        if self.0.iter().any(|k| k.dominates(&state)) {
+            return;
+        }
+        self.0.retain(|k| !state.dominates(k));
+        self.0.push(state);
+        if self.0.len() > MAX_FRONT_STATES {
+            self.merge_closest();
+        }
+    }
+
+    /// Replaces the two states nearest in speed by their coordinate-wise maximum.
+    fn merge_closest(&mut self) {
+        self.0.sort_by(|a, b| a.speed.total_cmp(&b.speed));
+        let Some(i) = (1..self.0.len()).min_by(|&i, &j| {
+            let di = self.0[i].speed - self.0[i - 1].speed;
+            let dj = self.0[j].speed - self.0[j - 1].speed;
+            di.total_cmp(&dj)
+        }) else {
+            return;
+        };
+        let (a, b) = (self.0[i - 1], self.0[i]);
+        self.0[i - 1] = ScheduleState {
+            speed: a.speed.max(b.speed),
+            covered: a.covered.max(b.covered),
+            covered_along: a.covered_along.max(b.covered_along),
+        };
+        self.0.remove(i);
+    }
+}
+
+/// The dynamic programme of [`jump_schedule_time_to_cover`].
+struct ScheduleSearch {
     bound: SpeedBound,
     tau: f64,
-    airtime: u64,
+    standing_airtime: u64,
+    ducked_airtime: u64,
     standing_from: u64,
     standing_law: Option<AccelLaw>,
     ducked_law: Option<AccelLaw>,
     crop: f64,
     ground_fixed_point: f64,
-    along_cap: f64,
     path_length: f64,
     progress_units: f64,
-    max_frames: u64,
-    best: Option<Crossing>,
-    steps: u64,
-    budget: Budget<'c>,
-    /// The budget ran out: the search is abandoned.
-    stopped: bool,
+    along_cap: f64,
 }
 
-/// Steps of the schedule search between two looks at its budget.
-const SCHEDULE_STEPS_PER_BUDGET_CHECK: u64 = 1 << 16;
-
-impl ScheduleSearch<'_> {
-    /// True when a schedule at `run` can no longer beat the best (or the budget or frame cap is spent).
-    fn pruned(&mut self, run: &ScheduleRun) -> bool {
-        if self.steps % SCHEDULE_STEPS_PER_BUDGET_CHECK == 0 && self.budget.expired() {
-            self.stopped = true;
-        }
-        self.stopped
-            || run.frames >= self.max_frames
-            || self.steps > MAX_SCHEDULE_SEARCH_STEPS
-            || self.best.is_some_and(|b| run.frames >= b.frames)
-    }
-
-    /// Plays one frame at `speed` (the speed after the frame's FME, which the move uses). Returns true
-    /// when both distances are covered, recording the crossing if it is the best.
-    fn play(&mut self, run: &mut ScheduleRun, speed: f64) -> bool {
-        self.steps += 1;
-        run.frames += 1;
+impl ScheduleSearch {
+    /// Plays one frame of `state` at `speed` (the speed after the frame's FME, which the move uses) as
+    /// frame `frame`: the new state, or the crossing when both distances are covered in it.
+    fn play(
+        &self,
+        state: &ScheduleState,
+        speed: f64,
+        frame: u64,
+    ) -> Result<ScheduleState, Crossing> {
         let tau = self.tau;
         let (step, along) = (speed * tau, speed.min(self.along_cap) * tau);
-        let done = |covered: f64, step: f64, target: f64| {
-            (covered + step >= target).then(|| {
-                let f = if step > 0.0 {
-                    ((target - covered) / step).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                Crossing::new(run.frames, f, tau)
-            })
-        };
-        if run.path_done.is_none() {
-            run.path_done = done(run.covered, step, self.path_length);
-        }
-        if run.along_done.is_none() {
-            run.along_done = done(run.covered_along, along, self.progress_units);
-        }
-        run.covered += step;
-        run.covered_along += along;
-        match (run.path_done, run.along_done) {
-            (Some(a), Some(b)) => {
-                let c = if a.time >= b.time { a } else { b };
-                if self.best.is_none_or(|best| c.time < best.time) {
-                    self.best = Some(c);
-                }
-                true
-            }
-            _ => false,
-        }
-    }
-
-    /// The player starts frame `run.frames + 1` on the ground at `speed`: branch on jumping in it or
-    /// staying on the ground, frame by frame, until the dominance rule says jump.
-    fn ground_phase(&mut self, mut run: ScheduleRun, mut speed: f64) {
-        loop {
-            if self.pruned(&run) {
-                return;
-            }
-            let frame = run.frames + 1;
-            let ducked = frame < self.standing_from;
-            let mut jumped = run;
-            let after_jump = self.bound.jump_next(speed, ducked.then_some(self.crop));
-            if !self.play(&mut jumped, after_jump) {
-                self.air_phase(jumped, after_jump);
-            }
-            if !ducked && speed >= self.ground_fixed_point {
-                return;
-            }
-            let law = if ducked {
-                self.ducked_law
+        let fraction = |covered: f64, step: f64, target: f64| -> f64 {
+            if covered >= target {
+                0.0
+            } else if step > 0.0 {
+                ((target - covered) / step).clamp(0.0, 1.0)
             } else {
-                self.standing_law
-            };
-            speed = self.bound.ground_next(speed, law);
-            if self.pruned(&run) || self.play(&mut run, speed) {
-                return;
+                1.0
             }
+        };
+        let covered = (state.covered + step).min(self.path_length);
+        let covered_along = (state.covered_along + along).min(self.progress_units);
+        if covered >= self.path_length && covered_along >= self.progress_units {
+            let f = fraction(state.covered, step, self.path_length).max(fraction(
+                state.covered_along,
+                along,
+                self.progress_units,
+            ));
+            return Err(Crossing::new(frame, f, tau));
         }
+        Ok(ScheduleState {
+            speed,
+            covered,
+            covered_along,
+        })
     }
 
-    /// The frames after a jump frame until the next frame that starts on the ground.
-    fn air_phase(&mut self, mut run: ScheduleRun, mut speed: f64) {
-        for _ in 1..self.airtime {
-            if self.pruned(&run) {
-                return;
-            }
-            speed = self.bound.air_next(speed);
-            if self.play(&mut run, speed) {
-                return;
+    /// The earliest crossing over all schedules from `speed` at the start, first on the ground in frame
+    /// `first_ground`, within `max_frames`.
+    fn run(
+        &self,
+        start_speed: f64,
+        first_ground: u64,
+        max_frames: u64,
+        budget: &Budget,
+    ) -> Option<Crossing> {
+        let longest = self.standing_airtime.max(self.ducked_airtime);
+        let phases = usize::try_from(longest).ok()?;
+        // fronts[0]: starts the frame on the ground; fronts[k]: airborne, k frames to the landing.
+        let mut fronts: Vec<Front> = vec![Front::default(); phases.max(1)];
+        let mut state = ScheduleState {
+            speed: start_speed,
+            covered: 0.0,
+            covered_along: 0.0,
+        };
+        // Falling towards the first landing: air frames.
+        for frame in 1..first_ground {
+            let speed = self.bound.air_next(state.speed);
+            match self.play(&state, speed, frame) {
+                Ok(next) => state = next,
+                Err(c) => return Some(c),
             }
         }
-        self.ground_phase(run, speed);
+        fronts[0].insert(state);
+        for frame in first_ground..=max_frames {
+            if frame % SCHEDULE_FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
+                return None;
+            }
+            let mut next: Vec<Front> = vec![Front::default(); fronts.len()];
+            let mut best: Option<Crossing> = None;
+            let mut keep = |phase: usize, r: Result<ScheduleState, Crossing>| match r {
+                Ok(st) => next[phase].insert(st),
+                Err(c) => {
+                    if best.is_none_or(|b| c.time < b.time) {
+                        best = Some(c);
+                    }
+                }
+            };
+            let ducked = frame < self.standing_from;
+            for st in &fronts[0].0 {
+                // Jump: standing (not before the unduck frame) or ducked.
+                let mut kinds: Vec<(Option<f64>, u64)> =
+                    vec![(Some(self.crop), self.ducked_airtime)];
+                if !ducked {
+                    kinds.push((None, self.standing_airtime));
+                }
+                for (crop, airtime) in kinds {
+                    let speed = self.bound.jump_next(st.speed, crop);
+                    let phase = usize::try_from(airtime - 1).unwrap_or(0);
+                    keep(phase, self.play(st, speed, frame));
+                }
+                let jump_at_once = !ducked
+                    && st.speed >= self.ground_fixed_point
+                    && self.bound.bhop_cap_speed.is_none_or(|t| st.speed <= t);
+                if !jump_at_once {
+                    let law = if ducked {
+                        self.ducked_law
+                    } else {
+                        self.standing_law
+                    };
+                    let speed = self.bound.ground_next(st.speed, law);
+                    keep(0, self.play(st, speed, frame));
+                }
+            }
+            for (phase, front) in fronts.iter().enumerate().skip(1) {
+                for st in &front.0 {
+                    let speed = self.bound.air_next(st.speed);
+                    keep(phase - 1, self.play(st, speed, frame));
+                }
+            }
+            if best.is_some() {
+                return best;
+            }
+            fronts = next;
+        }
+        None
     }
 }
 
@@ -696,5 +800,113 @@ mod jump_schedule_tests {
             assert!(b.ground_next(s, law) <= s + 1e-9, "{s}");
         }
         assert!(b.ground_next(0.5 * s_star, law) > 0.5 * s_star);
+    }
+
+    /// Every jump schedule, enumerated without pruning or merging: the earliest crossing from a state
+    /// that starts frame `frame` in `phase` (0: on the ground, `k`: `k` air frames to the landing).
+    fn exhaustive(
+        search: &ScheduleSearch,
+        state: ScheduleState,
+        frame: u64,
+        phase: u64,
+        max_frames: u64,
+    ) -> Option<Crossing> {
+        if frame > max_frames {
+            return None;
+        }
+        let mut best: Option<Crossing> = None;
+        let mut follow = |speed: f64, next_phase: u64| {
+            let c = match search.play(&state, speed, frame) {
+                Err(c) => Some(c),
+                Ok(next) => exhaustive(search, next, frame + 1, next_phase, max_frames),
+            };
+            if let Some(c) = c {
+                if best.is_none_or(|b| c.time < b.time) {
+                    best = Some(c);
+                }
+            }
+        };
+        if phase > 0 {
+            follow(search.bound.air_next(state.speed), phase - 1);
+            return best;
+        }
+        let ducked = frame < search.standing_from;
+        follow(
+            search.bound.jump_next(state.speed, Some(search.crop)),
+            search.ducked_airtime - 1,
+        );
+        if !ducked {
+            follow(
+                search.bound.jump_next(state.speed, None),
+                search.standing_airtime - 1,
+            );
+        }
+        let law = if ducked {
+            search.ducked_law
+        } else {
+            search.standing_law
+        };
+        follow(search.bound.ground_next(state.speed, law), 0);
+        best
+    }
+
+    /// The dynamic programme (Pareto fronts, the jump-at-once prune, the cap's envelope) finds the same
+    /// earliest crossing as enumerating every schedule, on short GoldSrc bunnyhop lanes starting on the
+    /// ground below, near and above the cap's speed (so the cut, the prune and ground braking all occur).
+    #[test]
+    fn the_schedule_programme_equals_exhaustive_enumeration() {
+        for (speed, length) in [
+            (320.0, 700.0),
+            (540.0, 900.0),
+            (600.0, 1000.0),
+            (700.0, 1100.0),
+        ] {
+            let text = format!(
+                "name = \"t\"\n[engine]\npreset = \"goldsrc\"\nfps = 100\neffects = [\"air-accel\", \
+                 \"ground-accel\", \"friction\", \"gravity\", \"jump\", \"bhop-cap\", \"max-velocity\"]\n\
+                 [start]\non-ground = true\nvelocity = [{speed}, 0]\n[lane]\nwidth = 256\nlength = {length}\n\
+                 kind = \"rule\"\n"
+            );
+            let scene = Scene::from_toml_str(&text, "t.toml").unwrap_or_else(|e| panic!("{e}"));
+            let distance = length - 40.0;
+            let progress = (Vec2::new(1.0, 0.0), distance);
+            let (search, first_ground) =
+                schedule_search(&scene, distance, progress).unwrap_or_else(|| panic!("a search"));
+            assert_eq!(first_ground, 1);
+            let dp = search.run(speed, first_ground, scene.max_frames, &Budget::unlimited());
+            let start = ScheduleState {
+                speed,
+                covered: 0.0,
+                covered_along: 0.0,
+            };
+            let all = exhaustive(&search, start, 1, 0, 400);
+            assert!(dp.is_some(), "{speed}");
+            assert_eq!(dp, all, "start {speed} ups, {distance} units");
+        }
+        // Half-Life 2 with the boost, a ducked start at rest: both jump kinds and their airtimes (35
+        // ticks standing, 36 ducked), the unduck frames.
+        for length in [300.0, 450.0] {
+            let text = format!(
+                "name = \"t\"\n[engine]\npreset = \"source-hl2\"\nfps = 66.666666666666667\nmaxspeed = 150\n\
+                 effects = [\"air-accel\", \"ground-accel\", \"friction\", \"gravity\", \"jump\", \
+                 \"jump-boost\", \"duck\", \"max-velocity\"]\n[start]\nvelocity = [0, 0]\non-ground = true\n\
+                 ducked = true\n[lane]\nwidth = 64\nlength = {length}\nkind = \"rule\"\n"
+            );
+            let scene = Scene::from_toml_str(&text, "t.toml").unwrap_or_else(|e| panic!("{e}"));
+            let distance = length - 40.0;
+            let (search, first_ground) =
+                schedule_search(&scene, distance, (Vec2::new(1.0, 0.0), distance))
+                    .unwrap_or_else(|| panic!("a search"));
+            assert_eq!((search.standing_airtime, search.ducked_airtime), (35, 36));
+            let dp = search.run(0.0, first_ground, scene.max_frames, &Budget::unlimited());
+            let start = ScheduleState {
+                speed: 0.0,
+                covered: 0.0,
+                covered_along: 0.0,
+            };
+            let all = exhaustive(&search, start, first_ground, 0, 200);
+            assert!(dp.is_some(), "{length}");
+            assert_eq!(dp, all, "{length} units");
+        }
     }
 }

@@ -598,10 +598,13 @@ mod tests {
         for t in [&strafing, &still] {
             let hops = hops_from_trace(t, tau);
             assert_eq!(hops.first().map(|h| h.frame), Some(23));
-            // Every hop lasts the airtime fixed by gravity: 36 ticks, no ground tick in between.
-            for h in &hops[..hops.len() - 1] {
+            // Every hop lasts the airtime fixed by gravity, no ground tick in between: 35 ticks after the
+            // standing first jump (160 ups added to the first gravity half-step), 36 after each ducked
+            // backhop (160 ups set; physics.md section 2).
+            for (i, h) in hops[..hops.len() - 1].iter().enumerate() {
+                let ticks = if i == 0 { 35.0 } else { 36.0 };
                 assert!(
-                    (h.hop_time.unwrap_or(0.0) - 36.0 * tau).abs() < 1e-12,
+                    (h.hop_time.unwrap_or(0.0) - ticks * tau).abs() < 1e-12,
                     "{h:?}"
                 );
             }

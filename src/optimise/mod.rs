@@ -1,9 +1,11 @@
 //! Optimisation over control sequences: the lower bound on the time ([`bound`]), the planning model of
-//! the minimal-time search ([`model`]), and the planner of jumping scenes ([`jumps`]).
+//! the minimal-time search ([`model`]), and the planners of scenes beyond air strafing: the Source jump
+//! boost ([`jumps`]) and ground frames, jumps and the bunnyhop cap ([`hops`]).
 
 mod baseline;
 pub mod bound;
 pub mod hillclimb;
+pub mod hops;
 pub mod jumps;
 pub mod lagrangian;
 pub mod model;

@@ -13,7 +13,7 @@
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
-use super::baseline::{baseline, GreedyGuide, GuideRun};
+use super::baseline::{baseline, corner_caps, GreedyGuide, GuideRun};
 use super::bound::lower_bound_within;
 use super::model::FrameControl;
 use super::planner::Planner;
@@ -130,10 +130,10 @@ pub enum SearchStatus {
         /// The stage that was cut.
         stopped_in: Stage,
     },
-    /// The scene uses effects the optimiser does not plan (ground, gravity, jumps): the greedy run is
-    /// returned.
-    GreedyOnly {
-        /// Which effects.
+    /// The greedy run is optimal: it crosses in the lower bound's frame, so no plan can cross earlier
+    /// (the greedy run is returned).
+    GreedyOptimal {
+        /// Why, with the frames.
         reason: String,
     },
     /// The optimiser found no valid plan better than the greedy one (which is returned).
@@ -177,7 +177,7 @@ impl std::fmt::Display for SearchStatus {
                 f,
                 "cancelled in the {stopped_in} stage, with the best valid plan so far"
             ),
-            SearchStatus::GreedyOnly { reason } => write!(f, "greedy plan returned: {reason}"),
+            SearchStatus::GreedyOptimal { reason } => write!(f, "greedy is optimal: {reason}"),
             SearchStatus::NoImprovement { reason } => write!(f, "greedy plan returned: {reason}"),
         }
     }
@@ -599,45 +599,43 @@ fn quantised_and_verified(planner: &mut Planner, plan: Vec<FrameControl>) -> Opt
     run.feasible().then_some((t, trace))
 }
 
-/// Jumping scenes with the Source boost: the policy search of [`super::jumps`]. It keeps a plan only if
-/// it is valid in f64 and engine-exact; greedy stays the answer when it is faster.
+/// Scenes with ground frames, gravity or jumps: greedy when it already crosses in the bound's frame
+/// (nothing can cross earlier); else the policy search of [`super::jumps`] (the Source jump boost) or of
+/// [`super::hops`] (everything else). Each keeps a plan only if it is valid in f64 and engine-exact;
+/// greedy stays the answer when it is faster.
 fn plan_jumping_scene(finisher: &Finisher, settings: &SearchSettings, budget: Budget) -> Outcome {
     let mut stats = SearchStats::default();
-    if let Some(plan) = super::jumps::plan_jumps(finisher.sim, settings, budget) {
-        stats.iterations = plan.evaluations;
-        let t = plan.best.time();
+    let greedy_status = super::hops::greedy_status(&finisher.greedy.trace, finisher.bound);
+    if matches!(greedy_status, SearchStatus::GreedyOptimal { .. }) {
+        return finisher.greedy_outcome(greedy_status, stats);
+    }
+    let scene = finisher.sim.scene();
+    let path = &finisher.bound.path;
+    let planned = super::jumps::plan_jumps(finisher.sim, settings, budget)
+        .map(|p| (p.best.trace, p.evaluations, p.timed_out))
+        .or_else(|| {
+            let caps = corner_caps(scene);
+            super::hops::plan_hops(finisher.sim, path, &caps, settings, budget)
+                .map(|p| (p.best.trace, p.evaluations, p.timed_out))
+        });
+    if let Some((trace, evaluations, timed_out)) = planned {
+        stats.iterations = evaluations;
+        let t = time_of(&trace);
         if t < time_of(&finisher.greedy.trace) {
-            let status = if plan.timed_out {
+            let status = if timed_out {
                 SearchStatus::stopped(&budget, Stage::Jumps)
             } else {
                 SearchStatus::Converged {
                     gap: finisher.gap(t),
                 }
             };
-            let best = plan.best;
-            return finisher.outcome(
-                best.trace.controls.clone(),
-                best.trace,
-                status,
-                stats,
-                "optimised",
-            );
+            return finisher.outcome(trace.controls.clone(), trace, status, stats, "optimised");
         }
     }
     if budget.expired() {
         return finisher.greedy_outcome(SearchStatus::stopped(&budget, Stage::Jumps), stats);
     }
-    let scene = finisher.sim.scene();
-    finisher.greedy_outcome(
-        SearchStatus::GreedyOnly {
-            reason: format!(
-                "the optimiser plans airborne strafing and Source jump-boost runs only; this scene also \
-                 runs {}",
-                scene.effects
-            ),
-        },
-        stats,
-    )
+    finisher.greedy_outcome(greedy_status, stats)
 }
 
 /// Checks a time limit given in seconds.

@@ -477,7 +477,13 @@ impl<R: Real> Stepper<R> {
                 s.vel = s.vel * scale;
             }
         }
-        s.vz = self.jump_speed;
+        // GoldSrc sets the jump speed; Source sets it ducked and adds it to the first gravity half-step
+        // standing (physics.md section 2).
+        s.vz = if self.game == Game::Source && !s.ducked {
+            s.vz + self.jump_speed
+        } else {
+            self.jump_speed
+        };
         s.on_ground = false;
         if self.effects.has(Effect::JumpBoost) {
             self.jump_boost(s, w);

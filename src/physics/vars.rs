@@ -49,8 +49,10 @@ impl Preset {
 
 /// GoldSrc's jump speed, `sqrt(2 * 800 * 45)` ups: the game hard-codes 800, whatever `sv_gravity` is.
 pub const GOLDSRC_JUMP_SPEED_UPS: f64 = 268.328_157_299_974_8;
-/// Source's jump height `GAMEMOVEMENT_JUMP_HEIGHT`, units: jump speed is `sqrt(2 g * 21)`.
-pub const SOURCE_JUMP_HEIGHT_UNITS: f64 = 21.0;
+/// Source's jump speed with movement optimisations on (the game's default), ups: Half-Life 2's
+/// `CGameMovement::CheckJumpButton` uses a fixed 160 (about 21 units high at `sv_gravity 600`), not
+/// `sqrt(2 g 21)` = 158.75 (docs/physics.md section 2).
+pub const SOURCE_JUMP_SPEED_UPS: f64 = 160.0;
 /// Bunnyhop cap threshold, a multiple of `sv_maxspeed` (docs/physics.md section 10).
 pub const BHOP_CAP_FACTOR: f64 = 1.7;
 /// Speed after the bunnyhop cap, a multiple of `sv_maxspeed` (`1.7 * 0.65`).
@@ -181,12 +183,23 @@ impl MovementVars {
         }
     }
 
-    /// The vertical speed a jump sets, ups (docs/physics.md section 2): `sqrt(2*800*45)` in GoldSrc (the game
-    /// hard-codes 800), `sqrt(2 g 21)` in Source.
+    /// The jump speed, ups (docs/physics.md section 2): `sqrt(2*800*45)` in GoldSrc (the game hard-codes 800),
+    /// 160 in Source. GoldSrc's jump always sets `v_z` to it; so does Source's when ducked, while a standing
+    /// Source jump adds it to `v_z` ([`MovementVars::jump_vz_ups`]).
     pub fn jump_speed_ups(&self) -> f64 {
         match self.game {
             Game::GoldSrc => GOLDSRC_JUMP_SPEED_UPS,
-            Game::Source => (2.0 * self.gravity * SOURCE_JUMP_HEIGHT_UNITS).sqrt(),
+            Game::Source => SOURCE_JUMP_SPEED_UPS,
+        }
+    }
+
+    /// The vertical speed right after a jump, ups, from `vz_ups` (the frame's `v_z` so far, which holds
+    /// the first half-step of gravity, `-g tau / 2`, on the flat floor) and whether the player is ducked
+    /// (docs/physics.md section 2): GoldSrc sets the jump speed; Source sets it ducked and adds it standing.
+    pub fn jump_vz_ups(&self, vz_ups: f64, ducked: bool) -> f64 {
+        match self.game {
+            Game::Source if !ducked => vz_ups + SOURCE_JUMP_SPEED_UPS,
+            _ => self.jump_speed_ups(),
         }
     }
 

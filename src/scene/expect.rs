@@ -27,7 +27,13 @@ use std::fmt;
 use toml::de::DeTable;
 
 /// The statuses `solve` reports (the `status` of its `--json`), in the words `[expect] status` takes.
-pub const SOLVE_STATUSES: [&str; 4] = ["converged", "time-limit", "greedy-only", "no-improvement"];
+pub const SOLVE_STATUSES: [&str; 5] = [
+    "converged",
+    "time-limit",
+    "cancelled",
+    "greedy-optimal",
+    "no-improvement",
+];
 
 /// `[expect]` as written: keys and types only. See the module documentation for each key.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize)]
@@ -93,7 +99,7 @@ pub enum ExpectController {
     Abh,
 }
 
-/// `status = "converged"` or `status = ["converged", "greedy-only"]`.
+/// `status = "converged"` or `status = ["converged", "greedy-optimal"]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StatusList(pub Vec<String>);
 

@@ -93,7 +93,9 @@ pub fn boost_addition(
 }
 
 /// Time from a jump back to the 2-unit ground layer, seconds (docs/physics.md section 10, with the scene's jump
-/// speed `v0` and gravity `g`): `(v0 + sqrt(v0^2 - 4 g)) / g`. `None` without gravity.
+/// speed `v0` and gravity `g`): `(v0 + sqrt(v0^2 - 4 g)) / g`, the airtime of a jump that sets `v_z = v0`
+/// (GoldSrc, or ducked in Source; a standing Source jump starts `g tau / 2` slower, section 2). `None`
+/// without gravity.
 pub fn jump_airtime_s(vars: &MovementVars) -> Option<f64> {
     let (v0, g) = (vars.jump_speed_ups(), vars.gravity);
     let disc = v0 * v0 - 2.0 * g * GROUND_LAYER_UNITS;

@@ -159,6 +159,15 @@ impl Controller for Greedy {
     }
 
     fn control(&mut self, _frame: u64, s: &PlayerState, sim: &Simulation) -> Control {
+        let (side, to_target) = self.steer(s, sim);
+        self.strafe(s, sim, scene_keys(sim), side, to_target)
+    }
+}
+
+impl Greedy {
+    /// The steering of a frame: the side that turns the velocity towards the look-ahead target, and the
+    /// vector to that target (see the type's documentation).
+    pub fn steer(&mut self, s: &PlayerState, sim: &Simulation) -> (Side, Vec2) {
         let here = self.project(s.pos);
         let mut lookahead = self.lookahead_units;
         let mut target = self.point_at(here + lookahead);
@@ -178,32 +187,39 @@ impl Controller for Greedy {
             Side::Right
         };
         self.last_side = side;
+        (side, to_target)
+    }
+
+    /// The strafe of a frame on `side` with `keys`: maximum acceleration (physics.md section 6), or at the
+    /// speed cap the speed held (section 8), braking from above (section 7).
+    pub fn strafe(
+        &self,
+        s: &PlayerState,
+        sim: &Simulation,
+        keys: Wish,
+        side: Side,
+        to_target: Vec2,
+    ) -> Control {
         match self.speed_cap_ups {
             Some(cap) if s.speed() >= cap => {
                 let before = s.speed();
-                strafe_control(
-                    sim.stepper(),
-                    s,
-                    scene_keys(sim),
-                    to_target.angle(),
-                    |lambda, law| {
-                        // Back to the cap, or held there; where one frame cannot reach it, as near as a
-                        // frame gets: braking (section 7) from above (a fast start before a corner),
-                        // accelerating from below.
-                        let target = before.min(cap);
-                        let cos =
-                            speed_preserving_cos_theta(target, lambda, law).unwrap_or_else(|| {
-                                if target < lambda {
-                                    max_decel(lambda, law).0
-                                } else {
-                                    max_accel(lambda, law).cos_theta
-                                }
-                            });
-                        side.sign() * theta_from_cos(cos)
-                    },
-                )
+                strafe_control(sim.stepper(), s, keys, to_target.angle(), |lambda, law| {
+                    // Back to the cap, or held there; where one frame cannot reach it, as near as a
+                    // frame gets: braking (section 7) from above (a fast start before a corner),
+                    // accelerating from below.
+                    let target = before.min(cap);
+                    let cos =
+                        speed_preserving_cos_theta(target, lambda, law).unwrap_or_else(|| {
+                            if target < lambda {
+                                max_decel(lambda, law).0
+                            } else {
+                                max_accel(lambda, law).cos_theta
+                            }
+                        });
+                    side.sign() * theta_from_cos(cos)
+                })
             }
-            _ => max_accel_control(sim.stepper(), s, scene_keys(sim), side, to_target.angle()),
+            _ => max_accel_control(sim.stepper(), s, keys, side, to_target.angle()),
         }
     }
 }

@@ -216,7 +216,7 @@
     switch (s.status) {
       case 'converged': return 'converged';
       case 'time-limit': return 'stopped by the time limit (best valid plan so far)';
-      case 'greedy-only': return 'greedy plan: ' + s.reason;
+      case 'greedy-optimal': return 'greedy is optimal: ' + s.reason;
       case 'no-improvement': return 'greedy plan: ' + s.reason;
       default: return s.status + (s.reason ? ': ' + s.reason : '');
     }
