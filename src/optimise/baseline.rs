@@ -248,17 +248,25 @@ pub(super) fn baseline(
         guide,
         trace: sim.run(&mut strafer(&guides[i].path, &guide)),
     };
+    // An invalid run kept is replayed within the budget: it may never end before the frame cap.
     let greedy = match (valid, fallback) {
-        (Some((_, i, guide)), _) | (None, Some((_, i, guide))) => replay(i, guide),
-        (None, None) => replay(
-            0,
-            GreedyGuide {
+        (Some((_, i, guide)), _) => replay(i, guide),
+        (None, Some((_, i, guide))) => GuideRun {
+            guide,
+            trace: sim.run_within(&mut strafer(&guides[i].path, &guide), budget),
+        },
+        (None, None) => {
+            let guide = GreedyGuide {
                 clearance_units: 0.0,
                 centre_line: false,
                 lookahead_units: GREEDY_LOOKAHEADS_UNITS[0],
                 speed_cap_ups: None,
-            },
-        ),
+            };
+            GuideRun {
+                guide,
+                trace: sim.run_within(&mut strafer(&guides[0].path, &guide), budget),
+            }
+        }
     };
     let clean = clean
         .into_iter()

@@ -452,10 +452,6 @@ fn solve_once(
         bound: &bound,
         started,
     };
-    if budget.expired() {
-        let status = SearchStatus::stopped(&budget, Stage::Greedy);
-        return Ok(finisher.greedy_outcome(status, SearchStats::default()));
-    }
     if !scene.effects.is_air_only() {
         return Ok(plan_jumping_scene(&finisher, settings, budget));
     }
