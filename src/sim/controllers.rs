@@ -3,8 +3,7 @@
 
 use super::{Controller, Simulation, Trace};
 use crate::physics::strafe::{
-    max_accel, max_accel_control, max_decel, speed_preserving_cos_theta, strafe_control,
-    strafe_keys, theta_from_cos,
+    max_accel, max_accel_control, max_decel, speed_preserving_cos_theta, strafe_keys, strafe_wish,
 };
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2, Wish};
 
@@ -180,27 +179,26 @@ impl Controller for Greedy {
         match self.speed_cap_ups {
             Some(cap) if s.speed() >= cap => {
                 let before = s.speed();
-                strafe_control(
+                Control::from_wish(&strafe_wish(
                     sim.stepper(),
                     s,
                     scene_keys(sim),
+                    side,
                     to_target.angle(),
                     |lambda, law| {
                         // Back to the cap, or held there; where one frame cannot reach it, as near as a
                         // frame gets: braking (section 7) from above (a fast start before a corner),
                         // accelerating from below.
                         let target = before.min(cap);
-                        let cos =
-                            speed_preserving_cos_theta(target, lambda, law).unwrap_or_else(|| {
-                                if target < lambda {
-                                    max_decel(lambda, law).0
-                                } else {
-                                    max_accel(lambda, law).cos_theta
-                                }
-                            });
-                        side.sign() * theta_from_cos(cos)
+                        speed_preserving_cos_theta(target, lambda, law).unwrap_or_else(|| {
+                            if target < lambda {
+                                max_decel(lambda, law).0
+                            } else {
+                                max_accel(lambda, law).cos_theta
+                            }
+                        })
                     },
-                )
+                ))
             }
             _ => max_accel_control(sim.stepper(), s, scene_keys(sim), side, to_target.angle()),
         }
