@@ -326,6 +326,9 @@ impl<R: Real> Stepper<R> {
     }
 
     /// One whole frame with a free horizontal move (no walls).
+    ///
+    /// Always inlined, with [`Stepper::prepare`]: it is the body of every frame loop, and only inlined does
+    /// the airborne frame run within a fifth of the same frame written by hand (docs/step-performance.md).
     #[inline(always)]
     pub fn step(&self, s: &mut PlayerState<R>, w: &Wish<R>) {
         if self.effects.is_air_only() {

@@ -2,6 +2,11 @@
 //! friction (ups), and the frame's [`AccelLaw`] (`L`, `gamma1`), and works with `cos theta`, where `theta`
 //! is the angle between `lambda(v)` and the wish direction. Speeds depend only on `cos theta`; the sign of
 //! `theta` picks the side. No function divides by a zero speed or takes `acos` of an unclamped value.
+//!
+//! A chosen angle becomes a frame's input in one of two forms: a [`Wish`] (the view vector, built from
+//! `cos theta` by rotations, no trigonometric function; what an `f64` frame loop steps) or a [`Control`]
+//! (the same with a yaw, for plans, reports and the engine-exact mode, which sends the yaw through
+//! anglemod): [`max_accel_wish`] and [`max_accel_control`], [`strafe_wish`].
 
 use super::real::Real;
 use super::step::{AccelLaw, Control, PlayerState, Side, Stepper, Wish};
@@ -61,56 +66,52 @@ pub struct MaxAccel {
 #[inline]
 pub fn max_accel(lambda: f64, law: AccelLaw) -> MaxAccel {
     let AccelLaw { l, gamma1 } = law;
+    let (case, cos_theta) = max_accel_cos_theta(lambda, law);
+    let speed = match case {
+        MaxAccelCase::One if l - gamma1 >= lambda => lambda + gamma1,
+        MaxAccelCase::One => (lambda * lambda + gamma1 * (2.0 * l - gamma1)).sqrt(),
+        MaxAccelCase::Two => lambda.hypot(l),
+        MaxAccelCase::Three | MaxAccelCase::Four => lambda,
+        MaxAccelCase::Five => lambda - gamma1,
+    };
+    MaxAccel {
+        case,
+        cos_theta,
+        speed,
+    }
+}
+
+/// The case and the optimal `cos Theta` of [`max_accel`] without the new speed: all a controller choosing
+/// its angle needs (physics.md section 6).
+#[inline]
+pub fn max_accel_cos_theta(lambda: f64, law: AccelLaw) -> (MaxAccelCase, f64) {
+    let AccelLaw { l, gamma1 } = law;
     if gamma1 >= 0.0 {
         if l >= 0.0 {
             if l - gamma1 >= 0.0 {
                 // Case 1: min(1, cos zeta).
                 if l - gamma1 >= lambda {
-                    MaxAccel {
-                        case: MaxAccelCase::One,
-                        cos_theta: 1.0,
-                        speed: lambda + gamma1,
-                    }
+                    (MaxAccelCase::One, 1.0)
                 } else {
-                    MaxAccel {
-                        case: MaxAccelCase::One,
-                        cos_theta: (l - gamma1) / lambda,
-                        speed: (lambda * lambda + gamma1 * (2.0 * l - gamma1)).sqrt(),
-                    }
+                    (MaxAccelCase::One, (l - gamma1) / lambda)
                 }
             } else {
-                MaxAccel {
-                    case: MaxAccelCase::Two,
-                    cos_theta: 0.0,
-                    speed: lambda.hypot(l),
-                }
+                (MaxAccelCase::Two, 0.0)
             }
         } else {
-            MaxAccel {
-                case: MaxAccelCase::Three,
-                cos_theta: 1.0,
-                speed: lambda,
-            }
+            (MaxAccelCase::Three, 1.0)
         }
     } else if l <= -lambda {
-        MaxAccel {
-            case: MaxAccelCase::Four,
-            cos_theta: 1.0,
-            speed: lambda,
-        }
+        (MaxAccelCase::Four, 1.0)
     } else {
-        MaxAccel {
-            case: MaxAccelCase::Five,
-            cos_theta: -1.0,
-            speed: lambda - gamma1,
-        }
+        (MaxAccelCase::Five, -1.0)
     }
 }
 
 /// The maximum-acceleration angle `Theta` in `[0, pi]`, radians (physics.md section 6).
 #[inline]
 pub fn max_accel_theta(lambda: f64, law: AccelLaw) -> f64 {
-    theta_from_cos(max_accel(lambda, law).cos_theta)
+    theta_from_cos(max_accel_cos_theta(lambda, law).1)
 }
 
 /// The candidate `cos theta` values at which the speed, as a function of `cos theta`, can have its extrema:
@@ -268,7 +269,7 @@ pub fn max_accel_control(
 
 /// The maximum-acceleration wish of this frame (see [`max_accel_control`]) in vector form, ready for
 /// [`Stepper::step`]: the wish direction is `lambda_hat` turned to `side` by the angle whose cosine is
-/// [`max_accel`]'s `cos Theta` (physics.md section 6), with no trigonometric function.
+/// [`max_accel_cos_theta`] (physics.md section 6), with no trigonometric function.
 #[inline]
 pub fn max_accel_wish(
     stepper: &Stepper<f64>,
@@ -278,7 +279,7 @@ pub fn max_accel_wish(
     heading_rad: f64,
 ) -> Wish {
     strafe_wish(stepper, state, keys, side, heading_rad, |lambda, law| {
-        max_accel(lambda, law).cos_theta
+        max_accel_cos_theta(lambda, law).1
     })
 }
 

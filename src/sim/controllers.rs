@@ -3,7 +3,8 @@
 
 use super::{Controller, Simulation, Trace};
 use crate::physics::strafe::{
-    max_accel, max_accel_control, max_decel, speed_preserving_cos_theta, strafe_keys, strafe_wish,
+    max_accel_control, max_accel_cos_theta, max_decel, speed_preserving_cos_theta, strafe_keys,
+    strafe_wish,
 };
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2, Wish};
 
@@ -194,7 +195,7 @@ impl Controller for Greedy {
                             if target < lambda {
                                 max_decel(lambda, law).0
                             } else {
-                                max_accel(lambda, law).cos_theta
+                                max_accel_cos_theta(lambda, law).1
                             }
                         })
                     },
