@@ -289,8 +289,9 @@ pub fn max_accel_wish(
 /// acceleration applies). `heading_rad` stands in for `lambda_hat` at zero speed.
 ///
 /// No trigonometric function: `sin theta = sqrt(1 - cos^2 theta)`, and the view vector is `a_hat` turned
-/// back by the keys' angle `kappa`, `f = R(kappa) a_hat` with `(cos kappa, sin kappa) = (F, S)/|(F, S)|`
-/// (the right vector is `f` turned clockwise, so `a_hat = cos kappa f + sin kappa s = R(-kappa) f`).
+/// back by the keys' angle `kappa`, `f = R(kappa) a_hat = R(theta) R(kappa) lambda_hat` with
+/// `(cos kappa, sin kappa) = (F, S)/|(F, S)|` (the right vector is `f` turned clockwise, so
+/// `a_hat = cos kappa f + sin kappa s = R(-kappa) f`).
 #[inline(always)]
 pub fn strafe_wish(
     stepper: &Stepper<f64>,
@@ -309,13 +310,15 @@ pub fn strafe_wish(
         .vel
         .normalized()
         .unwrap_or_else(|| Vec2::from_angle(heading_rad));
-    let a_hat = lambda_hat.rotated_cos_sin(cos_theta, sin_theta);
+    // f = R(kappa) R(theta) lambda_hat, with the keys' turn first: it needs only lambda_hat, so it is done
+    // while sin theta (a division and a square root later) is still being computed.
     let keys_len = Real::hypot(keys.forwardmove, keys.sidemove);
-    let forward = if keys_len > 0.0 {
-        a_hat.rotated_cos_sin(keys.forwardmove / keys_len, keys.sidemove / keys_len)
+    let lambda_hat_by_keys = if keys_len > 0.0 {
+        lambda_hat.rotated_cos_sin(keys.forwardmove / keys_len, keys.sidemove / keys_len)
     } else {
-        a_hat
+        lambda_hat
     };
+    let forward = lambda_hat_by_keys.rotated_cos_sin(cos_theta, sin_theta);
     Wish { forward, ..keys }
 }
 
