@@ -2,10 +2,17 @@
 //! (issue 3: simulate only the effects a scene calls for; target within 10%).
 //!
 //! Each iteration runs 1000 frames of a strafing sequence so the per-frame cost dominates.
+//!
+//! `max_accel_frame` times the whole greedy frame, choosing the maximum-acceleration angle and stepping,
+//! through the library beside the same loop written out by hand (`by_hand`); docs/step-performance.md
+//! holds the figures.
+
+mod by_hand;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
-use strafeopt::physics::{Effect, Effects, MovementVars, PlayerState, Stepper, Vec2, Wish};
+use strafeopt::physics::strafe::{max_accel_control, max_accel_wish, strafe_keys};
+use strafeopt::physics::{Effect, Effects, MovementVars, PlayerState, Side, Stepper, Vec2, Wish};
 
 const FRAMES: usize = 1000;
 
@@ -122,5 +129,66 @@ fn bench_steps(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_steps);
+/// The library's greedy frame in planning form: the maximum-acceleration wish (view vector, no yaw), then
+/// the step.
+#[inline(never)]
+fn max_accel_wish_frames(st: &Stepper<f64>, state: &mut PlayerState, frames: usize) {
+    let keys = strafe_keys(400.0);
+    let mut s = *state;
+    for _ in 0..frames {
+        let w = max_accel_wish(st, &s, keys, Side::Left, 0.0);
+        st.step(&mut s, &w);
+    }
+    *state = s;
+}
+
+/// The library's greedy frame with a yaw: the maximum-acceleration control, its wish, then the step.
+#[inline(never)]
+fn max_accel_control_frames(st: &Stepper<f64>, state: &mut PlayerState, frames: usize) {
+    let keys = strafe_keys(400.0);
+    let mut s = *state;
+    for _ in 0..frames {
+        let c = max_accel_control(st, &s, keys, Side::Left, 0.0);
+        st.step(&mut s, &c.wish());
+    }
+    *state = s;
+}
+
+/// Airborne maximum acceleration turning left at 1000 fps (case 1 of section 6: `gamma1 = 3.2 < L = 30`).
+fn bench_max_accel_frames(c: &mut Criterion) {
+    let vars = MovementVars::goldsrc(1000.0);
+    let st: Stepper<f64> = Stepper::new(&vars, Effects::AIR_ONLY);
+    let k = by_hand::AirFrameConstants {
+        l: vars.air_speed_cap,
+        gamma1: vars.entity_friction * vars.frame_time_s() * vars.maxspeed * vars.airaccelerate,
+        tau: vars.frame_time_s(),
+    };
+    let start = PlayerState::airborne(Vec2::ZERO, Vec2::new(320.0, 0.0));
+    let mut g = c.benchmark_group("max_accel_frame");
+    g.throughput(Throughput::Elements(FRAMES as u64));
+    g.bench_function("by_hand", |b| {
+        b.iter(|| {
+            let (mut pos, mut vel) = ([start.pos.x, start.pos.y], [start.vel.x, start.vel.y]);
+            by_hand::max_accel_left_frames(&mut pos, &mut vel, black_box(FRAMES), k);
+            black_box((pos, vel))
+        })
+    });
+    g.bench_function("max_accel_wish_step", |b| {
+        b.iter(|| {
+            let mut s = start;
+            max_accel_wish_frames(&st, &mut s, black_box(FRAMES));
+            black_box(s)
+        })
+    });
+    g.bench_function("max_accel_control_step", |b| {
+        b.iter(|| {
+            let mut s = start;
+            max_accel_control_frames(&st, &mut s, black_box(FRAMES));
+            black_box(s)
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_max_accel_frames, bench_steps);
 criterion_main!(benches);

@@ -6,7 +6,7 @@
 //! # Why a policy family is enough
 //!
 //! A frame of such a run is one of three kinds, and the physics fixes most of each:
-//! 1. **In the air** (physics.md sections 5-8) the view acts only through the wish direction, and the
+//! 1. **In the air** (docs/physics.md sections 5-8) the view acts only through the wish direction, and the
 //!    speed after the frame is any value between maximum deceleration (section 7) and maximum acceleration
 //!    (section 6), each on either side. The side steers (towards the corridor's guide, as the greedy
 //!    strafer does); the speed is the choice. Under the bunnyhop cap the speed wanted at the next landing
@@ -182,7 +182,7 @@ impl HopRunner {
 }
 
 /// `cos theta` of a frame that leaves at `target_ups` from `lambda` (the speed after friction) with `law`:
-/// maximum acceleration (physics.md section 6) when even that stays under the target, else the sharpest
+/// maximum acceleration (docs/physics.md section 6) when even that stays under the target, else the sharpest
 /// angle that gives the target (section 8's solutions), else maximum deceleration (section 7).
 pub fn cos_for_speed(lambda: f64, law: AccelLaw, target_ups: f64) -> f64 {
     let accel = max_accel(lambda, law);
@@ -446,7 +446,7 @@ fn descend(search: &mut HopSearch, grids: &Grids, corner_speeds_ups: &[f64]) -> 
         air_speeds.extend(grids.air_steps_ups.iter().map(|d| uncut + d));
     }
     air_speeds.extend(corner_speeds_ups.iter().copied());
-    // Take-off speeds: at once, shares of the groundstrafing top speed (physics.md section 12; the
+    // Take-off speeds: at once, shares of the groundstrafing top speed (docs/physics.md section 12; the
     // ground FME gains fastest far below it), never.
     let top = max_groundstrafe_speed(&scene.vars, fx.has(Effect::EdgeFriction));
     let mut takeoffs = vec![0.0];

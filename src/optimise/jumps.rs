@@ -600,7 +600,7 @@ mod tests {
             assert_eq!(hops.first().map(|h| h.frame), Some(23));
             // Every hop lasts the airtime fixed by gravity, no ground tick in between: 35 ticks after the
             // standing first jump (160 ups added to the first gravity half-step), 36 after each ducked
-            // backhop (160 ups set; physics.md section 2).
+            // backhop (160 ups set; docs/physics.md section 2).
             for (i, h) in hops[..hops.len() - 1].iter().enumerate() {
                 let ticks = if i == 0 { 35.0 } else { 36.0 };
                 assert!(

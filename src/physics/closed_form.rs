@@ -3,7 +3,7 @@
 
 use super::effects::{Effect, Effects};
 use super::step::{AccelLaw, PlayerState, Side, Stepper};
-use super::strafe::{max_accel_control, strafe_keys};
+use super::strafe::{max_accel_wish, strafe_keys};
 use super::vars::MovementVars;
 use super::vec2::Vec2;
 use crate::error::{Error, Result};
@@ -182,8 +182,8 @@ pub fn frames_to_speed_by_stepping(
     let mut frames = 0u64;
     while s.speed() < v1 {
         let before = s.speed();
-        let c = max_accel_control(&stepper, &s, keys, Side::Left, 0.0);
-        stepper.step(&mut s, &c.wish());
+        let w = max_accel_wish(&stepper, &s, keys, Side::Left, 0.0);
+        stepper.step(&mut s, &w);
         frames += 1;
         if frames >= max_frames || (frames > 16 && s.speed() <= before) {
             return Err(Error::Unreachable {
@@ -211,8 +211,8 @@ pub fn max_groundstrafe_speed_by_stepping(
     let mut frames = 0u64;
     loop {
         let before = s.speed();
-        let c = max_accel_control(&stepper, &s, keys, Side::Left, 0.0);
-        stepper.step(&mut s, &c.wish());
+        let w = max_accel_wish(&stepper, &s, keys, Side::Left, 0.0);
+        stepper.step(&mut s, &w);
         frames += 1;
         if ((s.speed() - before).abs() < tol_ups && frames > 2) || frames >= max_frames {
             return (s.speed(), frames);

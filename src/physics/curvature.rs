@@ -7,7 +7,7 @@
 
 use super::closed_form::strafing_effects;
 use super::step::{AccelLaw, PlayerState, Side, Stepper};
-use super::strafe::{max_accel, max_accel_control, mu_at, strafe_keys};
+use super::strafe::{max_accel, max_accel_wish, mu_at, strafe_keys};
 use super::vars::MovementVars;
 use super::vec2::Vec2;
 use crate::error::{Error, Result};
@@ -109,8 +109,8 @@ pub fn measured_radius(vars: &MovementVars, speed: f64) -> f64 {
     let mut pts = [Vec2::ZERO; 3];
     for p in pts.iter_mut() {
         *p = s.pos;
-        let c = max_accel_control(&stepper, &s, keys, Side::Left, 0.0);
-        stepper.step(&mut s, &c.wish());
+        let w = max_accel_wish(&stepper, &s, keys, Side::Left, 0.0);
+        stepper.step(&mut s, &w);
     }
     circumradius(pts[0], pts[1], pts[2])
 }

@@ -143,6 +143,31 @@ impl Side {
     }
 }
 
+impl Wish<f64> {
+    /// The unit wish direction `a_hat = (F f + S s)/sqrt(F^2 + S^2)` (docs/physics.md section 5), or `None` with
+    /// both keys zero. The duck crop and the max-speed clamp scale both keys alike, so they leave it alone.
+    #[inline]
+    pub fn direction(&self) -> Option<Vec2> {
+        let len = Real::hypot(self.forwardmove, self.sidemove);
+        if len > 0.0 {
+            let f = self.forward;
+            let right = Vec2::new(f.y, -f.x);
+            Some((f * self.forwardmove + right * self.sidemove) * (1.0 / len))
+        } else {
+            None
+        }
+    }
+
+    /// The angle `theta` (radians, in `[-pi, pi]`) from `vel` to the wish direction (positive: left), for
+    /// reports. Zero when the velocity or the keys are zero.
+    pub fn theta_rad(&self, vel: Vec2) -> f64 {
+        match self.direction() {
+            Some(a_hat) if vel.length_squared() > 0.0 => vel.cross(a_hat).atan2(vel.dot(a_hat)),
+            _ => 0.0,
+        }
+    }
+}
+
 impl Control {
     /// The wish vectors of this control (`f` from the yaw).
     #[inline]
@@ -153,6 +178,19 @@ impl Control {
             sidemove: self.sidemove,
             jump: self.jump,
             duck: self.duck,
+        }
+    }
+
+    /// The control of a wish given in vector form: the yaw is the angle of the forward view vector, in
+    /// `(-pi, pi]` (one `atan2`). [`Control::wish`] gives the vector back to within rounding.
+    #[inline]
+    pub fn from_wish(w: &Wish<f64>) -> Self {
+        Control {
+            yaw_rad: w.forward.angle(),
+            forwardmove: w.forwardmove,
+            sidemove: w.sidemove,
+            jump: w.jump,
+            duck: w.duck,
         }
     }
 
@@ -181,15 +219,10 @@ impl Control {
         }
     }
 
-    /// The angle `theta` (radians, in `(-pi, pi]`) between `vel` and this control's wish direction, for
+    /// The angle `theta` (radians, in `[-pi, pi]`) between `vel` and this control's wish direction, for
     /// reports. Zero when the velocity or the keys are zero.
     pub fn theta_rad(&self, vel: Vec2) -> f64 {
-        if vel.length_squared() == 0.0 || (self.forwardmove == 0.0 && self.sidemove == 0.0) {
-            return 0.0;
-        }
-        let wish_angle = self.yaw_rad - self.sidemove.atan2(self.forwardmove);
-        let d = wish_angle - vel.angle();
-        d.sin().atan2(d.cos())
+        self.wish().theta_rad(vel)
     }
 }
 
@@ -293,19 +326,30 @@ impl<R: Real> Stepper<R> {
     }
 
     /// One whole frame with a free horizontal move (no walls).
-    #[inline]
+    ///
+    /// Always inlined, with [`Stepper::prepare`]: it is the body of every frame loop, and only inlined does
+    /// the airborne frame run within a fifth of the same frame written by hand (docs/step-performance.md).
+    #[inline(always)]
     pub fn step(&self, s: &mut PlayerState<R>, w: &Wish<R>) {
         if self.effects.is_air_only() {
             self.air_step(s, w);
         } else {
-            self.pre_move(s, w);
-            s.pos += s.vel * self.tau;
-            self.post_move(s);
+            *s = self.full_step(*s, w);
         }
     }
 
+    /// Every step of the frame, for effect sets beyond the airborne-only one. Kept out of line so that
+    /// [`Stepper::step`] stays small enough to inline into a caller's frame loop, and by value so that the
+    /// caller's state never escapes into a call: the loop can then hold it in registers.
+    fn full_step(&self, mut s: PlayerState<R>, w: &Wish<R>) -> PlayerState<R> {
+        self.pre_move(&mut s, w);
+        s.pos += s.vel * self.tau;
+        self.post_move(&mut s);
+        s
+    }
+
     /// The airborne-only frame: steps 4 and 5 of docs/physics.md section 3 and nothing else.
-    #[inline]
+    #[inline(always)]
     fn air_step(&self, s: &mut PlayerState<R>, w: &Wish<R>) {
         if self.effects.has(Effect::MaxVelocity) {
             self.clamp_horizontal(s);
@@ -332,8 +376,41 @@ impl<R: Real> Stepper<R> {
     /// Returns the wish direction and the acceleration law (docs/physics.md section 5) when an acceleration
     /// effect applies this frame. The law does not depend on the view direction, so a controller can call
     /// this on a copy of the state to choose its angle from `lambda(v)`.
-    #[inline]
+    #[inline(always)]
     pub fn prepare(&self, s: &mut PlayerState<R>, w: &Wish<R>) -> Option<(V2<R>, AccelLaw<R>)> {
+        if self.effects.is_air_only() && !s.on_ground {
+            // What the steps below come to in the air with none of duck, gravity, jump or friction.
+            self.clamp_all(s);
+            let (a_hat, m) = self.wish_direction(w, s.ducked, false);
+            return self
+                .effects
+                .has(Effect::AirAccel)
+                .then(|| (a_hat, self.air_law(m)));
+        }
+        let (prepared, out) = self.prepare_all(*s, *w);
+        *s = prepared;
+        out
+    }
+
+    /// [`Stepper::prepare`] for any effect set and state, out of line and by value (see
+    /// [`Stepper::full_step`]).
+    #[allow(clippy::type_complexity)]
+    fn prepare_all(
+        &self,
+        mut state: PlayerState<R>,
+        w: Wish<R>,
+    ) -> (PlayerState<R>, Option<(V2<R>, AccelLaw<R>)>) {
+        let out = self.prepare_every_effect(&mut state, &w);
+        (state, out)
+    }
+
+    /// Steps 1-3 and the clamp of step 4 for any effect set and state.
+    #[inline]
+    fn prepare_every_effect(
+        &self,
+        s: &mut PlayerState<R>,
+        w: &Wish<R>,
+    ) -> Option<(V2<R>, AccelLaw<R>)> {
         let fx = self.effects;
         if fx.has(Effect::Duck) {
             self.duck(s, w.duck);
@@ -478,7 +555,7 @@ impl<R: Real> Stepper<R> {
             }
         }
         // GoldSrc sets the jump speed; Source sets it ducked and adds it to the first gravity half-step
-        // standing (physics.md section 2).
+        // standing (docs/physics.md section 2).
         s.vz = if self.game == Game::Source && !s.ducked {
             s.vz + self.jump_speed
         } else {

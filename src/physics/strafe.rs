@@ -2,7 +2,13 @@
 //! friction (ups), and the frame's [`AccelLaw`] (`L`, `gamma1`), and works with `cos theta`, where `theta`
 //! is the angle between `lambda(v)` and the wish direction. Speeds depend only on `cos theta`; the sign of
 //! `theta` picks the side. No function divides by a zero speed or takes `acos` of an unclamped value.
+//!
+//! A chosen angle becomes a frame's input in one of two forms: a [`Wish`] (the view vector, built from
+//! `cos theta` by rotations, no trigonometric function; what an `f64` frame loop steps) or a [`Control`]
+//! (the same with a yaw, for plans, reports and the engine-exact mode, which sends the yaw through
+//! anglemod): [`max_accel_wish`] and [`max_accel_control`], [`strafe_wish`].
 
+use super::real::Real;
 use super::step::{AccelLaw, Control, PlayerState, Side, Stepper, Wish};
 use super::vec2::Vec2;
 
@@ -57,58 +63,55 @@ pub struct MaxAccel {
 /// Maximum acceleration (docs/physics.md section 6, all five cases). `lambda` may be zero: the direction is then
 /// lost and `cos Theta` refers to the view direction. `cos zeta = (L - gamma1)/lambda` and
 /// `cos zeta_bar = L/lambda` are compared by multiplying through by `lambda`, never divided by zero.
+#[inline]
 pub fn max_accel(lambda: f64, law: AccelLaw) -> MaxAccel {
+    let AccelLaw { l, gamma1 } = law;
+    let (case, cos_theta) = max_accel_cos_theta(lambda, law);
+    let speed = match case {
+        MaxAccelCase::One if l - gamma1 >= lambda => lambda + gamma1,
+        MaxAccelCase::One => (lambda * lambda + gamma1 * (2.0 * l - gamma1)).sqrt(),
+        MaxAccelCase::Two => lambda.hypot(l),
+        MaxAccelCase::Three | MaxAccelCase::Four => lambda,
+        MaxAccelCase::Five => lambda - gamma1,
+    };
+    MaxAccel {
+        case,
+        cos_theta,
+        speed,
+    }
+}
+
+/// The case and the optimal `cos Theta` of [`max_accel`] without the new speed: all a controller choosing
+/// its angle needs (docs/physics.md section 6).
+#[inline]
+pub fn max_accel_cos_theta(lambda: f64, law: AccelLaw) -> (MaxAccelCase, f64) {
     let AccelLaw { l, gamma1 } = law;
     if gamma1 >= 0.0 {
         if l >= 0.0 {
             if l - gamma1 >= 0.0 {
                 // Case 1: min(1, cos zeta).
                 if l - gamma1 >= lambda {
-                    MaxAccel {
-                        case: MaxAccelCase::One,
-                        cos_theta: 1.0,
-                        speed: lambda + gamma1,
-                    }
+                    (MaxAccelCase::One, 1.0)
                 } else {
-                    MaxAccel {
-                        case: MaxAccelCase::One,
-                        cos_theta: (l - gamma1) / lambda,
-                        speed: (lambda * lambda + gamma1 * (2.0 * l - gamma1)).sqrt(),
-                    }
+                    (MaxAccelCase::One, (l - gamma1) / lambda)
                 }
             } else {
-                MaxAccel {
-                    case: MaxAccelCase::Two,
-                    cos_theta: 0.0,
-                    speed: lambda.hypot(l),
-                }
+                (MaxAccelCase::Two, 0.0)
             }
         } else {
-            MaxAccel {
-                case: MaxAccelCase::Three,
-                cos_theta: 1.0,
-                speed: lambda,
-            }
+            (MaxAccelCase::Three, 1.0)
         }
     } else if l <= -lambda {
-        MaxAccel {
-            case: MaxAccelCase::Four,
-            cos_theta: 1.0,
-            speed: lambda,
-        }
+        (MaxAccelCase::Four, 1.0)
     } else {
-        MaxAccel {
-            case: MaxAccelCase::Five,
-            cos_theta: -1.0,
-            speed: lambda - gamma1,
-        }
+        (MaxAccelCase::Five, -1.0)
     }
 }
 
 /// The maximum-acceleration angle `Theta` in `[0, pi]`, radians (docs/physics.md section 6).
 #[inline]
 pub fn max_accel_theta(lambda: f64, law: AccelLaw) -> f64 {
-    theta_from_cos(max_accel(lambda, law).cos_theta)
+    theta_from_cos(max_accel_cos_theta(lambda, law).1)
 }
 
 /// The candidate `cos theta` values at which the speed, as a function of `cos theta`, can have its extrema:
@@ -250,6 +253,10 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
 /// turning to `side`: the stepper's own friction and law are applied to a copy of the state, then the yaw is
 /// set so that the wish direction makes the angle [`max_accel_theta`] with `lambda(v)` (docs/physics.md
 /// section 6). `heading_rad` is used at zero speed. The returned control carries the given buttons.
+///
+/// This is [`max_accel_wish`] with its view vector turned into a yaw (one `atan2`); a loop that only
+/// steps the `f64` planning physics can step that wish directly and skip the yaw.
+#[inline]
 pub fn max_accel_control(
     stepper: &Stepper<f64>,
     state: &PlayerState,
@@ -257,9 +264,62 @@ pub fn max_accel_control(
     side: Side,
     heading_rad: f64,
 ) -> Control {
-    strafe_control(stepper, state, keys, heading_rad, |lambda, law| {
-        side.sign() * max_accel_theta(lambda, law)
+    Control::from_wish(&max_accel_wish(stepper, state, keys, side, heading_rad))
+}
+
+/// The maximum-acceleration wish of this frame (see [`max_accel_control`]) in vector form, ready for
+/// [`Stepper::step`]: the wish direction is `lambda_hat` turned to `side` by the angle whose cosine is
+/// [`max_accel_cos_theta`] (docs/physics.md section 6), with no trigonometric function.
+#[inline]
+pub fn max_accel_wish(
+    stepper: &Stepper<f64>,
+    state: &PlayerState,
+    keys: Wish,
+    side: Side,
+    heading_rad: f64,
+) -> Wish {
+    strafe_wish(stepper, state, keys, side, heading_rad, |lambda, law| {
+        max_accel_cos_theta(lambda, law).1
     })
+}
+
+/// The wish of this frame whose direction makes the angle `theta` with `lambda(v)` (docs/physics.md section 5:
+/// `a_hat = R(theta) lambda_hat`), turning to `side`, where `cos theta = pick_cos_theta(lambda, law)` from
+/// the frame's speed after friction and acceleration law (clamped into `[-1, 1]`; `cos theta = 1` when no
+/// acceleration applies). `heading_rad` stands in for `lambda_hat` at zero speed.
+///
+/// No trigonometric function: `sin theta = sqrt(1 - cos^2 theta)`, and the view vector is `a_hat` turned
+/// back by the keys' angle `kappa`, `f = R(kappa) a_hat = R(theta) R(kappa) lambda_hat` with
+/// `(cos kappa, sin kappa) = (F, S)/|(F, S)|` (the right vector is `f` turned clockwise, so
+/// `a_hat = cos kappa f + sin kappa s = R(-kappa) f`).
+#[inline(always)]
+pub fn strafe_wish(
+    stepper: &Stepper<f64>,
+    state: &PlayerState,
+    keys: Wish,
+    side: Side,
+    heading_rad: f64,
+    pick_cos_theta: impl FnOnce(f64, AccelLaw) -> f64,
+) -> Wish {
+    let mut probe = *state;
+    let law = stepper.prepare(&mut probe, &keys).map(|(_, law)| law);
+    let lambda = probe.vel.length();
+    let cos_theta = law.map_or(1.0, |law| pick_cos_theta(lambda, law).clamp(-1.0, 1.0));
+    let sin_theta = side.sign() * (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let lambda_hat = probe
+        .vel
+        .normalized()
+        .unwrap_or_else(|| Vec2::from_angle(heading_rad));
+    // f = R(kappa) R(theta) lambda_hat, with the keys' turn first: it needs only lambda_hat, so it is done
+    // while sin theta (a division and a square root later) is still being computed.
+    let keys_len = Real::hypot(keys.forwardmove, keys.sidemove);
+    let lambda_hat_by_keys = if keys_len > 0.0 {
+        lambda_hat.rotated_cos_sin(keys.forwardmove / keys_len, keys.sidemove / keys_len)
+    } else {
+        lambda_hat
+    };
+    let forward = lambda_hat_by_keys.rotated_cos_sin(cos_theta, sin_theta);
+    Wish { forward, ..keys }
 }
 
 /// A control whose strafe angle is chosen by `pick_theta(lambda, law)` from the frame's speed after friction
@@ -327,6 +387,86 @@ mod tests {
             );
             assert!(m.speed.is_finite() && m.cos_theta.abs() <= 1.0);
         }
+    }
+
+    /// The wish direction of a control, as the step computes it.
+    fn a_hat(st: &Stepper<f64>, w: &Wish) -> Vec2 {
+        st.wish_direction(w, false, false).0
+    }
+
+    #[test]
+    fn the_wish_turns_lambda_hat_by_the_chosen_angle_without_trigonometry() {
+        use super::super::effects::{Effect, Effects};
+        use super::super::vars::MovementVars;
+        let vars = MovementVars::goldsrc(100.0);
+        let ground_fx = Effects::from_list(&[Effect::GroundAccel, Effect::Friction]);
+        let air: Stepper<f64> = Stepper::new(&vars, Effects::AIR_ONLY);
+        let ground: Stepper<f64> = Stepper::new(&vars, ground_fx);
+        let key_sets = [
+            (0.0, 400.0),
+            (400.0, 0.0),
+            (400.0, -400.0),
+            (-250.0, 100.0),
+            (0.0, 0.0),
+        ];
+        let vels = [
+            Vec2::new(320.0, 0.0),
+            Vec2::new(-700.0, 150.0),
+            Vec2::new(0.0, -20.0),
+        ];
+        for (st, on_ground) in [(&air, false), (&ground, true)] {
+            for &(f, sm) in &key_sets {
+                for &vel in &vels {
+                    for side in [Side::Left, Side::Right] {
+                        let s = PlayerState {
+                            on_ground,
+                            ..PlayerState::airborne(Vec2::ZERO, vel)
+                        };
+                        let keys = Wish {
+                            forwardmove: f,
+                            sidemove: sm,
+                            ..strafe_keys(0.0)
+                        };
+                        let w = max_accel_wish(st, &s, keys, side, 1.0);
+                        assert!((w.forward.length() - 1.0).abs() < 1e-15);
+                        // The same frame planned through angles: Control::strafe at +-Theta.
+                        let mut probe = s;
+                        let law = st.prepare(&mut probe, &keys).map(|(_, l)| l);
+                        let theta = law.map_or(0.0, |l| max_accel_theta(probe.vel.length(), l));
+                        let by_angles =
+                            Control::strafe(probe.vel, 1.0, side.sign() * theta, f, sm).wish();
+                        assert!(
+                            (w.forward - by_angles.forward).length() < 1e-12,
+                            "{f} {sm} {vel:?} {side:?}: {:?} vs {:?}",
+                            w.forward,
+                            by_angles.forward
+                        );
+                        if f != 0.0 || sm != 0.0 {
+                            let lambda_hat = probe.vel.normalized().unwrap_or(Vec2::new(1.0, 0.0));
+                            let a = a_hat(st, &w);
+                            assert!((a.dot(lambda_hat) - theta.cos()).abs() < 1e-12);
+                            assert!(side.sign() * lambda_hat.cross(a) >= -1e-12);
+                        }
+                        // The control is the same wish with a yaw: one atan2 there, sin_cos back.
+                        let c = max_accel_control(st, &s, keys, side, 1.0);
+                        assert!((c.wish().forward - w.forward).length() < 1e-15);
+                        assert_eq!((c.forwardmove, c.sidemove), (f, sm));
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn at_zero_speed_the_heading_stands_in_for_the_velocity() {
+        use super::super::effects::Effects;
+        use super::super::vars::MovementVars;
+        let st: Stepper<f64> = Stepper::new(&MovementVars::goldsrc(100.0), Effects::AIR_ONLY);
+        let s = PlayerState::airborne(Vec2::ZERO, Vec2::ZERO);
+        // At rest L - gamma1 = 30 - 32 < 0 is case 2: cos Theta = 0, the wish a quarter turn off the heading.
+        let w = max_accel_wish(&st, &s, strafe_keys(400.0), Side::Left, 0.5);
+        let a = a_hat(&st, &w);
+        assert!((a - Vec2::from_angle(0.5 + std::f64::consts::FRAC_PI_2)).length() < 1e-12);
     }
 
     #[test]

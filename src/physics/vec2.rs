@@ -111,9 +111,16 @@ impl Vec2 {
     #[inline]
     pub fn rotated(self, angle_rad: f64) -> Self {
         let (s, c) = angle_rad.sin_cos();
+        self.rotated_cos_sin(c, s)
+    }
+
+    /// Rotated anticlockwise by the angle whose cosine and sine are given (R(theta) of docs/physics.md
+    /// section 5 without a trigonometric function; `cos^2 + sin^2 = 1` is the caller's to keep).
+    #[inline]
+    pub fn rotated_cos_sin(self, cos_angle: f64, sin_angle: f64) -> Self {
         V2 {
-            x: c * self.x - s * self.y,
-            y: s * self.x + c * self.y,
+            x: cos_angle * self.x - sin_angle * self.y,
+            y: sin_angle * self.x + cos_angle * self.y,
         }
     }
 }

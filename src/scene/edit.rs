@@ -47,7 +47,7 @@ pub struct SceneEdit {
 pub struct EngineEdit {
     /// The preset the variables start from.
     pub preset: Preset,
-    /// The effects simulated (physics.md section 3).
+    /// The effects simulated (docs/physics.md section 3).
     pub effects: Vec<Effect>,
     /// Changes to the preset (`fps` is required by validation; `airaccelerate`, ...).
     pub vars: VarOverrides,

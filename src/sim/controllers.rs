@@ -4,8 +4,8 @@
 use super::{Controller, RunSummary, Simulation, Trace};
 use crate::budget::Budget;
 use crate::physics::strafe::{
-    max_accel, max_accel_control, max_decel, speed_preserving_cos_theta, strafe_control,
-    strafe_keys, theta_from_cos,
+    max_accel_control, max_accel_cos_theta, max_decel, speed_preserving_cos_theta, strafe_keys,
+    strafe_wish,
 };
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2, Wish};
 
@@ -190,7 +190,7 @@ impl Greedy {
         (side, to_target)
     }
 
-    /// The strafe of a frame on `side` with `keys`: maximum acceleration (physics.md section 6), or at the
+    /// The strafe of a frame on `side` with `keys`: maximum acceleration (docs/physics.md section 6), or at the
     /// speed cap the speed held (section 8), braking from above (section 7).
     pub fn strafe(
         &self,
@@ -203,21 +203,26 @@ impl Greedy {
         match self.speed_cap_ups {
             Some(cap) if s.speed() >= cap => {
                 let before = s.speed();
-                strafe_control(sim.stepper(), s, keys, to_target.angle(), |lambda, law| {
-                    // Back to the cap, or held there; where one frame cannot reach it, as near as a
-                    // frame gets: braking (section 7) from above (a fast start before a corner),
-                    // accelerating from below.
-                    let target = before.min(cap);
-                    let cos =
+                Control::from_wish(&strafe_wish(
+                    sim.stepper(),
+                    s,
+                    keys,
+                    side,
+                    to_target.angle(),
+                    |lambda, law| {
+                        // Back to the cap, or held there; where one frame cannot reach it, as near as a
+                        // frame gets: braking (section 7) from above (a fast start before a corner),
+                        // accelerating from below.
+                        let target = before.min(cap);
                         speed_preserving_cos_theta(target, lambda, law).unwrap_or_else(|| {
                             if target < lambda {
                                 max_decel(lambda, law).0
                             } else {
-                                max_accel(lambda, law).cos_theta
+                                max_accel_cos_theta(lambda, law).1
                             }
-                        });
-                    side.sign() * theta_from_cos(cos)
-                })
+                        })
+                    },
+                ))
             }
             _ => max_accel_control(sim.stepper(), s, keys, side, to_target.angle()),
         }

@@ -13,7 +13,7 @@ pub mod trace;
 use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 use crate::error::Result;
 use crate::geometry::{BoundaryKind, Corridor};
-use crate::physics::{Control, Effect, PlayerState, Stepper, Vec2};
+use crate::physics::{Control, Effect, PlayerState, Stepper, Vec2, Wish};
 use crate::scene::Scene;
 pub use controllers::{Greedy, Playback, SideStrafer};
 pub use trace::{Crossing, FrameRecord, Trace};
@@ -82,9 +82,14 @@ impl<'s> Simulation<'s> {
     /// of wall contacts and whether a rule line was crossed.
     #[inline]
     pub fn frame(&self, s: &mut PlayerState, c: &Control) -> FrameOutcome {
+        self.frame_wish(s, &c.wish())
+    }
+
+    /// [`Simulation::frame`] with the control already in vector form.
+    #[inline]
+    pub fn frame_wish(&self, s: &mut PlayerState, wish: &Wish) -> FrameOutcome {
         let before = s.pos;
-        let wish = c.wish();
-        self.stepper.pre_move(s, &wish);
+        self.stepper.pre_move(s, wish);
         let mut contacts = 0;
         if self.solid_walls {
             let r = self
@@ -173,8 +178,9 @@ impl<'s> Simulation<'s> {
                 break;
             }
             let c = controller.control(frame, &s, self);
-            let theta = c.theta_rad(s.vel);
-            let out = self.frame(&mut s, &c);
+            let wish = c.wish();
+            let theta = wish.theta_rad(s.vel);
+            let out = self.frame_wish(&mut s, &wish);
             if !s.is_finite() {
                 // The run stops at the last finite state; the failing frame is not recorded.
                 trace.numerical_failure = true;
