@@ -26,6 +26,8 @@ pub enum Command {
     Report(ReportArgs),
     /// Measure what accuracy costs in time: every level from the lower bound to the engine-exact plan.
     Bench(super::bench::BenchArgs),
+    /// Write random valid corridors (seeded) as scene files.
+    Gen(super::gen::GenArgs),
 }
 
 /// Output files every run can write besides `--trajectory`.

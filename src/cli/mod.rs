@@ -4,7 +4,9 @@
 
 pub mod args;
 pub mod bench;
+pub mod bench_generated;
 pub mod calc;
+pub mod gen;
 pub mod report_cmd;
 pub mod simulate;
 pub mod solve;
@@ -121,6 +123,7 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
         Command::Solve(a) => solve::run(a),
         Command::Report(a) => report_cmd::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Gen(a) => gen::run(a),
         Command::Calc(c) => {
             let figures = calc::run(&c.form)?;
             if calc::wants_json(&c.form) {

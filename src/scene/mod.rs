@@ -39,6 +39,7 @@
 //! [`geometry`]: crate::geometry
 
 mod file;
+pub mod generate;
 mod locate;
 pub mod shorthand;
 mod validate;
