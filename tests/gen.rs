@@ -23,6 +23,12 @@ fn sample(settings: &GeneratorSettings, count: u64) -> Vec<GeneratedScene> {
     generate_sample(SAMPLE_SEED, count, settings).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The whole family's sample, drawn once for the tests that share it.
+fn family_sample() -> &'static [GeneratedScene] {
+    static SAMPLE: std::sync::OnceLock<Vec<GeneratedScene>> = std::sync::OnceLock::new();
+    SAMPLE.get_or_init(|| sample(&GeneratorSettings::default(), SAMPLE_COUNT))
+}
+
 /// How far inside a piece of the corridor a wall point may be and still count as on its edge, units:
 /// the files' coordinates are rounded to 0.0005.
 const INSIDE_TOL_UNITS: f64 = 0.01;
@@ -137,17 +143,15 @@ fn assert_matches_drawn(g: &GeneratedScene) {
 #[test]
 fn five_hundred_scenes_of_the_family_are_valid_and_never_overlap_themselves() {
     let settings = GeneratorSettings::default();
-    for g in sample(&settings, SAMPLE_COUNT) {
-        assert_valid(&g, f64::from(settings.wall_gap_units));
-        assert_matches_drawn(&g);
+    for g in family_sample() {
+        assert_valid(g, f64::from(settings.wall_gap_units));
+        assert_matches_drawn(g);
     }
 }
 
 #[test]
 fn the_draws_stay_in_their_ranges_and_cover_them() {
-    let s = GeneratorSettings::default();
-    let scenes = sample(&s, SAMPLE_COUNT);
-    let drawn: Vec<_> = scenes.iter().map(|g| &g.drawn).collect();
+    let drawn: Vec<_> = family_sample().iter().map(|g| &g.drawn).collect();
     let corners: BTreeSet<usize> = drawn.iter().map(|d| d.turns.len()).collect();
     assert_eq!(
         corners,
@@ -443,4 +447,8 @@ fn bench_generated_gives_a_record_per_scene_and_the_distributions() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--fps"));
     let out = run(&["bench", "--generated", "0"]);
     assert_eq!(out.status.code(), Some(2));
+    // The scene-file levels are not the generated bench's.
+    let out = run(&["bench", "--generated", "1", "--levels", "exact"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--levels"));
 }

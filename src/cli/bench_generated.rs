@@ -25,6 +25,21 @@ pub fn run(args: &BenchArgs) -> Result<String> {
             allowed: "given without scene files (the scenes are generated)".to_string(),
         });
     }
+    let scene_flags = [
+        (args.quick, "--quick"),
+        (!args.levels.is_empty(), "--levels"),
+        (args.svg.is_some(), "--svg"),
+        (args.no_hill_climb, "--no-hill-climb"),
+        (args.no_scaling, "--no-scaling"),
+    ];
+    if let Some((_, flag)) = scene_flags.iter().find(|(given, _)| *given) {
+        return Err(Error::InvalidValue {
+            name: flag.to_string(),
+            value: "given with --generated".to_string(),
+            allowed: "given for scene files only (with --generated, --quality sets the level)"
+                .to_string(),
+        });
+    }
     let settings = args.family.settings()?;
     let seed = args.seed.unwrap_or(DEFAULT_SEED);
     let q = args.quality.map_or(Quality::Fast, quality);
