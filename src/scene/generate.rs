@@ -328,16 +328,7 @@ pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<G
     let gap = f64::from(settings.wall_gap_units);
 
     for draw in 1..=settings.max_corridor_draws {
-        let turns: Vec<(u32, Side)> = (0..corners)
-            .map(|_| {
-                let degrees = rng.in_range(settings.min_turn_deg, settings.max_turn_deg);
-                let side = if rng.coin() { Side::Left } else { Side::Right };
-                (degrees, side)
-            })
-            .collect();
-        let legs_units: Vec<u32> = (0..=corners)
-            .map(|_| rng.in_range(settings.min_leg_units, settings.max_leg_units))
-            .collect();
+        let (turns, legs_units) = draw_corridor(&mut rng, corners, settings);
         let layout = lay_out(&Shape {
             width_units: width,
             gap_units: gap,
@@ -380,6 +371,25 @@ pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<G
             settings.max_corridor_draws
         ),
     })
+}
+
+/// One draw of a corridor: each turn's angle and side, then each leg's length (one more than the turns).
+fn draw_corridor(
+    rng: &mut SplitMix64,
+    corners: u32,
+    settings: &GeneratorSettings,
+) -> (Vec<(u32, Side)>, Vec<u32>) {
+    let turns = (0..corners)
+        .map(|_| {
+            let degrees = rng.in_range(settings.min_turn_deg, settings.max_turn_deg);
+            let side = if rng.coin() { Side::Left } else { Side::Right };
+            (degrees, side)
+        })
+        .collect();
+    let legs = (0..=corners)
+        .map(|_| rng.in_range(settings.min_leg_units, settings.max_leg_units))
+        .collect();
+    (turns, legs)
 }
 
 /// Scenes `0..count` of the family `seed`: the fixed sample tests and benches use.
