@@ -1,18 +1,19 @@
 //! Random valid corridors, seeded: a family of scenes the optimiser was never tuned on.
 //!
 //! [`generate`] draws one scene from a seed and an item index with the generator's own SplitMix64 stream
-//! ([`rng`]), so item `k` of seed `N` is the same whatever the number of items drawn, on every machine. A
+//! (`generate/rng.rs`), so item `k` of seed `N` is the same whatever the number of items drawn, on every machine. A
 //! scene is an airborne Half-Life (`goldsrc`) run through a corridor: a centre line of straight legs and
-//! 1 to 6 turns of 30 to 180 degrees to either side ([`centreline`]), 64 to 256 units wide, legs of 200 to
+//! 1 to 6 turns of 30 to 180 degrees to either side (`generate/centreline.rs`), 64 to 256 units wide, legs of 200 to
 //! 1500 units, at 100, 250 or 1000 fps with `sv_airaccelerate` 10 or 100, starting at 0 to 1500 ups along
-//! the first leg, between rule or solid walls ([`GeneratorSettings::default`]; the issue's family).
+//! the first leg, between rule or solid walls (docs/physics.md section 10): the default family,
+//! [`GeneratorSettings::default`].
 //!
 //! What is drawn, in this order from the item's stream: the number of turns, the width, the frame rate,
 //! the air acceleration, the start speed and the wall kind; then the corridor, each turn's angle (whole
 //! degrees) and side and each leg's length (whole units), drawn again from the same stream until the
 //! corridor does not overlap itself (at most [`GeneratorSettings::max_corridor_draws`] times).
 //!
-//! Decisions the issue left open:
+//! Choices of shape:
 //! - a leg's length is its straight part: the first from the start wall to the first turn, the last from
 //!   the last turn to the finish line (a 180-degree turn has no corner point to measure to);
 //! - a turn goes around a pivot `(width + gap) / 2` to its side, so a 180-degree turn leaves a divider
@@ -70,7 +71,7 @@ pub const FPS_RANGE: std::ops::RangeInclusive<u32> = 10..=10_000;
 pub const AIRACCELERATE_RANGE: std::ops::RangeInclusive<u32> = 1..=1000;
 
 /// The family to draw from: every range inclusive, in whole units, degrees, fps and ups. `Default` is the
-/// issue's family; [`GeneratorSettings::ci_sized`] a smaller one whose solves take seconds.
+/// full family; [`GeneratorSettings::ci_sized`] a smaller one whose solves take seconds.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct GeneratorSettings {
     /// Fewest turns (at least 1).
@@ -537,7 +538,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn default_settings_are_the_issues_family_and_valid() {
+    fn default_settings_are_the_full_family_and_valid() {
         let s = GeneratorSettings::default();
         assert!(s.validate().is_ok());
         assert_eq!((s.min_corners, s.max_corners), (1, 6));
