@@ -1,11 +1,12 @@
 //! Random valid corridors, seeded: a family of scenes the optimiser was never tuned on.
 //!
 //! [`generate`] draws one scene from a seed and an item index with the generator's own SplitMix64 stream
-//! (`generate/rng.rs`), so item `k` of seed `N` is the same whatever the number of items drawn, on every machine. A
-//! scene is an airborne Half-Life (`goldsrc`) run through a corridor: a centre line of straight legs and
-//! 1 to 6 turns of 30 to 180 degrees to either side (`generate/centreline.rs`), 64 to 256 units wide, legs of 200 to
-//! 1500 units, at 100, 250 or 1000 fps with `sv_airaccelerate` 10 or 100, starting at 0 to 1500 ups along
-//! the first leg, between rule or solid walls (docs/physics.md section 10): the default family,
+//! (`generate/rng.rs`), so item `k` of seed `N` is the same whatever the number of items drawn, on every
+//! machine. A scene is an airborne Half-Life (`goldsrc`) run through a corridor: a centre line of straight
+//! legs and 1 to 6 turns of 30 to 180 degrees to either side (`generate/centreline.rs`), 64 to 256 units
+//! wide, legs of 200 to 1500 units, at 100, 250 or 1000 fps with `sv_airaccelerate` 10 or 100, starting at
+//! 0 to 1500 ups along the first leg, between rule or solid walls (docs/physics.md section 10): the default
+//! family,
 //! [`GeneratorSettings::default`].
 //!
 //! What is drawn, in this order from the item's stream: the number of turns, the width, the frame rate,
