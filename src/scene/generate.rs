@@ -6,8 +6,7 @@
 //! legs and 1 to 6 turns of 30 to 180 degrees to either side (`generate/centreline.rs`), 64 to 256 units
 //! wide, legs of 200 to 1500 units, at 100, 250 or 1000 fps with `sv_airaccelerate` 10 or 100, starting at
 //! 0 to 1500 ups along the first leg, between rule or solid walls (docs/physics.md section 10): the default
-//! family,
-//! [`GeneratorSettings::default`].
+//! family, [`GeneratorSettings::default`].
 //!
 //! What is drawn, in this order from the item's stream: the number of turns, the width, the frame rate,
 //! the air acceleration, the start speed and the wall kind; then the corridor, each turn's angle (whole
