@@ -8,6 +8,8 @@
 //!
 //! Wall times are measured around each call with [`Instant`], on whatever machine runs it: they are
 //! measurements, not targets (speed targets live in `benches/`).
+//!
+//! [`generated`] solves generated scenes and gives the distribution of their results.
 
 use crate::error::{Error, Result};
 use crate::geometry::HULL_HALF_WIDTH_UNITS;
@@ -19,6 +21,8 @@ use crate::sim::controllers::{best_capped_greedy, best_greedy, GREEDY_LOOKAHEADS
 use crate::sim::{Crossing, Simulation};
 use serde::Serialize;
 use std::time::{Duration, Instant};
+
+pub mod generated;
 
 /// Which part of the table a row belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

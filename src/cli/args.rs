@@ -30,6 +30,8 @@ pub enum Command {
     Check(CheckArgs),
     /// Serve the planner page on a local port: edit a corridor, see the optimal and greedy lines.
     Serve(ServeArgs),
+    /// Write random valid corridors (seeded) as scene files.
+    Gen(super::gen::GenArgs),
 }
 
 /// `strafeopt check [PATHS...]`

@@ -1,6 +1,7 @@
 //! `strafeopt bench`: what accuracy costs in time. Loads the scenes, runs
 //! [`crate::bench::measure_scene`] on each and [`crate::bench::measure_scaling`] on the first, and prints
-//! an aligned table or (`--json`) one array of rows; `--svg` writes gap against wall time.
+//! an aligned table or (`--json`) one array of rows; `--svg` writes gap against wall time. With
+//! `--generated N` it solves N generated scenes instead ([`super::bench_generated`]).
 
 use super::args::QualityArg;
 use super::{progress, write_atomically};
@@ -43,7 +44,7 @@ pub struct BenchArgs {
     /// Leave out the hill-climbing baseline.
     #[arg(long)]
     pub no_hill_climb: bool,
-    /// Seed of the hill climber.
+    /// Seed: of the generated scenes with --generated (default 1), else of the hill climber.
     #[arg(long)]
     pub seed: Option<u64>,
     /// Stop each solve after this many seconds with its best valid plan.
@@ -55,15 +56,27 @@ pub struct BenchArgs {
     /// Most frames a solve plans (see `solve --max-frames`; default 100000).
     #[arg(long)]
     pub max_frames: Option<u64>,
-    /// Print one JSON array of rows instead of a table.
+    /// Print one JSON array of rows instead of a table (with --generated: one object with the
+    /// distributions and a record per scene).
     #[arg(long)]
     pub json: bool,
+    /// Solve this many generated scenes (`strafeopt gen`, scenes 0 to N-1 of --seed) instead of scene
+    /// files, and print the distribution of their results.
+    #[arg(long, allow_negative_numbers = true)]
+    pub generated: Option<i64>,
+    /// Quality of each solve with --generated (default fast).
+    #[arg(long, value_enum, requires = "generated")]
+    pub quality: Option<QualityArg>,
+    /// With --generated: flags that narrow the family, as for `strafeopt gen`.
+    #[command(flatten)]
+    pub family: super::gen::FamilyFlags,
     /// Print no progress on stderr.
     #[arg(long, short = 'q')]
     pub quiet: bool,
 }
 
-fn quality(q: QualityArg) -> Quality {
+/// The library's quality level.
+pub fn quality(q: QualityArg) -> Quality {
     match q {
         QualityArg::Fast => Quality::Fast,
         QualityArg::Balanced => Quality::Balanced,
@@ -82,6 +95,16 @@ fn bend_width(path: &Path) -> Option<f64> {
 
 /// Runs `bench` and returns what to print.
 pub fn run(args: &BenchArgs) -> Result<String> {
+    if args.generated.is_some() {
+        return super::bench_generated::run(args);
+    }
+    if let Some(flag) = args.family.first_given() {
+        return Err(Error::InvalidValue {
+            name: flag.to_string(),
+            value: "given without --generated".to_string(),
+            allowed: "given with --generated (it narrows the generated family)".to_string(),
+        });
+    }
     let mut settings = BenchSettings {
         hill_climb: !args.no_hill_climb,
         ..BenchSettings::default()

@@ -5,8 +5,10 @@
 
 pub mod args;
 pub mod bench;
+pub mod bench_generated;
 pub mod calc;
 pub mod check;
+pub mod gen;
 pub mod progress;
 pub mod report_cmd;
 pub mod serve;
@@ -132,6 +134,7 @@ pub fn run(cli: &Cli) -> Result<String, Error> {
         Command::Bench(a) => bench::run(a),
         Command::Check(a) => check::run(a).map(|(out, _)| out),
         Command::Serve(a) => serve::run(a),
+        Command::Gen(a) => gen::run(a),
         Command::Calc(c) => {
             let figures = calc::run(&c.form)?;
             if calc::wants_json(&c.form) {

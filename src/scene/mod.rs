@@ -45,6 +45,7 @@
 pub mod edit;
 pub mod expect;
 mod file;
+pub mod generate;
 mod locate;
 pub mod shorthand;
 mod validate;

@@ -1,0 +1,291 @@
+//! `solve` on generated scenes ([`crate::scene::generate`]): one [`SceneRecord`] per scene, and the
+//! distribution (min, median, 90th percentile, max) of each named [`Column`] over the records. A column is
+//! a name and a function of a record; adding one to [`columns`] is one line.
+//!
+//! Wall times are measured around each solve with [`Instant`]: measurements, not targets.
+
+use crate::geometry::BoundaryKind;
+use crate::optimise::{solve, Quality, SearchSettings};
+use crate::scene::generate::GeneratedScene;
+use serde::Serialize;
+use std::time::{Duration, Instant};
+
+/// One generated scene solved.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SceneRecord {
+    /// Scene name, `gen-SEED-INDEX`.
+    pub scene: String,
+    /// Turns of the corridor.
+    pub corners: usize,
+    /// Corridor width, units.
+    pub width_units: u32,
+    /// Frame rate, fps.
+    pub fps: u32,
+    /// `sv_airaccelerate`.
+    pub airaccelerate: u32,
+    /// Start speed, ups.
+    pub start_speed_ups: u32,
+    /// Wall kind.
+    pub walls: BoundaryKind,
+    /// The plan's crossing frame.
+    pub frames: Option<u64>,
+    /// The plan's crossing time, game seconds.
+    pub time_s: Option<f64>,
+    /// The plan reaches the line without breaking a rule.
+    pub valid: bool,
+    /// The plan is also valid in the engine-exact mode.
+    pub engine_exact_valid: bool,
+    /// The greedy baseline's crossing frame (valid or not).
+    pub greedy_frames: Option<u64>,
+    /// The greedy baseline reached the line without breaking a rule.
+    pub greedy_valid: bool,
+    /// The lower bound's crossing frame.
+    pub bound_frames: Option<u64>,
+    /// The lower bound's time, game seconds.
+    pub bound_time_s: Option<f64>,
+    /// Greedy frames less the plan's, when both are valid.
+    pub frames_gained: Option<i64>,
+    /// `(time - bound) / bound`, percent, for a valid plan.
+    pub gap_pct: Option<f64>,
+    /// Wall-clock time of the solve, seconds.
+    pub solve_seconds: f64,
+    /// Solve wall time per frame of the plan, milliseconds.
+    pub solve_ms_per_frame: Option<f64>,
+    /// `solve`'s status and the plan's source, or the error.
+    pub status: String,
+}
+
+impl SceneRecord {
+    fn new(g: &GeneratedScene) -> Self {
+        let d = &g.drawn;
+        SceneRecord {
+            scene: g.name.clone(),
+            corners: d.turns.len(),
+            width_units: d.width_units,
+            fps: d.fps,
+            airaccelerate: d.airaccelerate,
+            start_speed_ups: d.start_speed_ups,
+            walls: d.walls,
+            frames: None,
+            time_s: None,
+            valid: false,
+            engine_exact_valid: false,
+            greedy_frames: None,
+            greedy_valid: false,
+            bound_frames: None,
+            bound_time_s: None,
+            frames_gained: None,
+            gap_pct: None,
+            solve_seconds: 0.0,
+            solve_ms_per_frame: None,
+            status: String::new(),
+        }
+    }
+}
+
+/// Solves `g` at `quality` (with an optional time limit) and records the outcome; a solve that fails is
+/// a record with its error as the status, not an error.
+pub fn measure_generated_scene(
+    g: &GeneratedScene,
+    quality: Quality,
+    time_limit: Option<Duration>,
+) -> SceneRecord {
+    let mut r = SceneRecord::new(g);
+    let mut settings = SearchSettings::for_quality(quality);
+    settings.time_limit = time_limit;
+    let started = Instant::now();
+    let outcome = solve(&g.scene, &settings);
+    r.solve_seconds = started.elapsed().as_secs_f64();
+    let out = match outcome {
+        Ok(out) => out,
+        Err(e) => {
+            r.status = format!("error: {e}");
+            return r;
+        }
+    };
+    r.frames = out.trace.crossing.map(|c| c.frames);
+    r.time_s = out.trace.crossing.map(|c| c.time);
+    r.valid = out.trace.feasible();
+    r.engine_exact_valid = out.engine_exact.feasible();
+    r.greedy_frames = out.greedy.crossing.map(|c| c.frames);
+    r.greedy_valid = out.greedy.feasible();
+    r.bound_frames = Some(out.bound.crossing.frames);
+    r.bound_time_s = Some(out.bound.crossing.time);
+    if r.valid {
+        let bound = out.bound.crossing.time;
+        r.gap_pct = r
+            .time_s
+            .map(|t| 100.0 * (t - bound) / bound.max(f64::MIN_POSITIVE));
+        if r.greedy_valid {
+            r.frames_gained = r
+                .greedy_frames
+                .zip(r.frames)
+                .map(|(g, p)| g as i64 - p as i64);
+        }
+    }
+    r.solve_ms_per_frame = r
+        .frames
+        .filter(|&f| f > 0)
+        .map(|f| 1000.0 * r.solve_seconds / f as f64);
+    r.status = format!("{} ({})", out.status, out.source);
+    r
+}
+
+/// [`measure_generated_scene`] on each scene in turn, calling `progress` with each record.
+pub fn measure_generated(
+    scenes: &[GeneratedScene],
+    quality: Quality,
+    time_limit: Option<Duration>,
+    progress: &mut dyn FnMut(usize, &SceneRecord),
+) -> Vec<SceneRecord> {
+    scenes
+        .iter()
+        .enumerate()
+        .map(|(i, g)| {
+            let r = measure_generated_scene(g, quality, time_limit);
+            progress(i, &r);
+            r
+        })
+        .collect()
+}
+
+/// A named figure of a record; `None` where the record has none (an invalid plan has no gap).
+#[derive(Clone, Copy, Debug)]
+pub struct Column {
+    /// The name printed, with its unit.
+    pub name: &'static str,
+    /// The figure.
+    pub value: fn(&SceneRecord) -> Option<f64>,
+}
+
+/// The columns of the distribution table, in order.
+pub fn columns() -> Vec<Column> {
+    vec![
+        Column {
+            name: "frames gained on greedy",
+            value: |r| r.frames_gained.map(|f| f as f64),
+        },
+        Column {
+            name: "gap to bound (%)",
+            value: |r| r.gap_pct,
+        },
+        Column {
+            name: "solve time per frame (ms)",
+            value: |r| r.solve_ms_per_frame,
+        },
+        Column {
+            name: "solve time (s)",
+            value: |r| Some(r.solve_seconds),
+        },
+    ]
+}
+
+/// The distribution of one column over the records that have it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Distribution {
+    /// The column's name.
+    pub column: &'static str,
+    /// Records with a value.
+    pub count: usize,
+    /// Smallest value.
+    pub min: Option<f64>,
+    /// Median ([`quantile`] 0.5).
+    pub median: Option<f64>,
+    /// 90th percentile ([`quantile`] 0.9).
+    pub p90: Option<f64>,
+    /// Largest value.
+    pub max: Option<f64>,
+}
+
+/// The `q` quantile of ascending `sorted` values by linear interpolation between closest ranks
+/// (`sorted[(n - 1) q]`, interpolated; numpy's default); `None` when empty.
+pub fn quantile(sorted: &[f64], q: f64) -> Option<f64> {
+    let last = sorted.len().checked_sub(1)?;
+    let at = last as f64 * q.clamp(0.0, 1.0);
+    let lo = at.floor() as usize;
+    let hi = at.ceil() as usize;
+    let (a, b) = (sorted[lo], sorted[hi.min(last)]);
+    Some(a + (b - a) * (at - lo as f64))
+}
+
+/// The distribution of each column over `records`.
+pub fn distributions(records: &[SceneRecord], columns: &[Column]) -> Vec<Distribution> {
+    columns
+        .iter()
+        .map(|c| {
+            let mut v: Vec<f64> = records
+                .iter()
+                .filter_map(c.value)
+                .filter(|x| x.is_finite())
+                .collect();
+            v.sort_by(f64::total_cmp);
+            Distribution {
+                column: c.name,
+                count: v.len(),
+                min: v.first().copied(),
+                median: quantile(&v, 0.5),
+                p90: quantile(&v, 0.9),
+                max: v.last().copied(),
+            }
+        })
+        .collect()
+}
+
+/// Records for which `pred` holds, and all records.
+pub fn share(records: &[SceneRecord], pred: impl Fn(&SceneRecord) -> bool) -> (usize, usize) {
+    (records.iter().filter(|r| pred(r)).count(), records.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_interpolate_between_ranks() {
+        let v = [1.0, 2.0, 3.0, 4.0];
+        assert_eq!(quantile(&v, 0.5), Some(2.5));
+        assert_eq!(quantile(&v, 0.0), Some(1.0));
+        assert_eq!(quantile(&v, 1.0), Some(4.0));
+        // (n - 1) 0.9 = 2.7: 3 + 0.7 (4 - 3).
+        assert!((quantile(&v, 0.9).unwrap_or(f64::NAN) - 3.7).abs() < 1e-12);
+        assert_eq!(quantile(&[5.0], 0.9), Some(5.0));
+        assert_eq!(quantile(&[], 0.5), None);
+    }
+
+    #[test]
+    fn distributions_skip_records_without_the_figure() {
+        let rec = |gained: Option<i64>, seconds: f64| SceneRecord {
+            scene: "s".to_string(),
+            corners: 1,
+            width_units: 64,
+            fps: 100,
+            airaccelerate: 10,
+            start_speed_ups: 0,
+            walls: BoundaryKind::Rule,
+            frames: Some(100),
+            time_s: Some(1.0),
+            valid: true,
+            engine_exact_valid: true,
+            greedy_frames: None,
+            greedy_valid: gained.is_some(),
+            bound_frames: Some(99),
+            bound_time_s: Some(0.99),
+            frames_gained: gained,
+            gap_pct: Some(1.0),
+            solve_seconds: seconds,
+            solve_ms_per_frame: Some(10.0 * seconds),
+            status: String::new(),
+        };
+        let records = [rec(Some(3), 1.0), rec(None, 2.0), rec(Some(9), 3.0)];
+        let d = distributions(&records, &columns());
+        assert_eq!(d[0].column, "frames gained on greedy");
+        assert_eq!(d[0].count, 2);
+        assert_eq!(
+            (d[0].min, d[0].median, d[0].max),
+            (Some(3.0), Some(6.0), Some(9.0))
+        );
+        let time = d.iter().find(|c| c.column == "solve time (s)");
+        assert_eq!(time.map(|c| (c.count, c.median)), Some((3, Some(2.0))));
+        assert_eq!(share(&records, |r| r.greedy_valid), (2, 3));
+    }
+}

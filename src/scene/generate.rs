@@ -1,0 +1,582 @@
+//! Random valid corridors, seeded: a family of scenes the optimiser was never tuned on.
+//!
+//! [`generate`] draws one scene from a seed and an item index with the generator's own SplitMix64 stream
+//! (`generate/rng.rs`), so item `k` of seed `N` is the same whatever the number of items drawn, on every
+//! machine. A scene is an airborne Half-Life (`goldsrc`) run through a corridor: a centre line of straight
+//! legs and 1 to 6 turns of 30 to 180 degrees to either side (`generate/centreline.rs`), 64 to 256 units
+//! wide, legs of 200 to 1500 units, at 100, 250 or 1000 fps with `sv_airaccelerate` 10 or 100, starting at
+//! 0 to 1500 ups along the first leg, between rule or solid walls (docs/physics.md section 10): the default
+//! family, [`GeneratorSettings::default`].
+//!
+//! What is drawn, in this order from the item's stream: the number of turns, the width, the frame rate,
+//! the air acceleration, the start speed and the wall kind; then the corridor, each turn's angle (whole
+//! degrees) and side and each leg's length (whole units), drawn again from the same stream until the
+//! corridor does not overlap itself (at most [`GeneratorSettings::max_corridor_draws`] times).
+//!
+//! Choices of shape:
+//! - a leg's length is its straight part: the first from the start wall to the first turn, the last from
+//!   the last turn to the finish line (a 180-degree turn has no corner point to measure to);
+//! - a turn goes around a pivot `(width + gap) / 2` to its side, so a 180-degree turn leaves a divider
+//!   `gap` units thick ([`GeneratorSettings::wall_gap_units`], 16) between the legs; the walls follow the
+//!   turn's arcs as polygons, and parts of the corridor that are not neighbours keep their walls at least
+//!   `gap / 2` apart;
+//! - the start is the hull centre [`START_OFFSET_UNITS`] into the first leg on its centre line (as the
+//!   shorthand shapes), airborne; the start wall closes the corridor behind it; the finish line spans the
+//!   last leg's end, wall to wall;
+//! - coordinates are written with three decimals and the scene is the one read back from that text, so
+//!   a file and the [`GeneratedScene::scene`] it came with are the same scene.
+//!
+//! The first leg runs along +x from the origin. Nothing here runs the physics: a scene is checked by the
+//! scene validator (start clear of the walls, a path for the hull to the finish).
+
+mod centreline;
+mod rng;
+
+pub use centreline::{CentrelinePiece, Side};
+pub use rng::SplitMix64;
+
+use super::{Scene, START_OFFSET_UNITS};
+use crate::error::{Error, Result};
+use crate::geometry::BoundaryKind;
+use crate::physics::Vec2;
+use centreline::{lay_out, overlaps_itself, Shape};
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// Default of [`GeneratorSettings::max_corridor_draws`].
+pub const MAX_CORRIDOR_DRAWS: u32 = 10_000;
+
+/// Most turns a corridor may have.
+pub const MAX_CORNERS: u32 = 12;
+
+/// Narrowest corridor, units: the hull's 32 units and 8 of room.
+pub const MIN_WIDTH_UNITS: u32 = 40;
+
+/// Widest corridor, units.
+pub const MAX_WIDTH_UNITS: u32 = 2048;
+
+/// Shortest leg, units: the start hull, [`START_OFFSET_UNITS`] into the first leg, must fit.
+pub const MIN_LEG_UNITS: u32 = 64;
+
+/// Longest leg, units: 13 legs and their turns stay far inside the scene's coordinate range.
+pub const MAX_LEG_UNITS: u32 = 20_000;
+
+/// Largest start speed, ups: GoldSrc's `sv_maxvelocity`, which clamps each velocity component.
+pub const MAX_START_SPEED_UPS: u32 = 2000;
+
+/// Frame rates accepted, fps.
+pub const FPS_RANGE: std::ops::RangeInclusive<u32> = 10..=10_000;
+
+/// `sv_airaccelerate` values accepted.
+pub const AIRACCELERATE_RANGE: std::ops::RangeInclusive<u32> = 1..=1000;
+
+/// The family to draw from: every range inclusive, in whole units, degrees, fps and ups. `Default` is the
+/// full family; [`GeneratorSettings::ci_sized`] a smaller one whose solves take seconds.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct GeneratorSettings {
+    /// Fewest turns (at least 1).
+    pub min_corners: u32,
+    /// Most turns (at most [`MAX_CORNERS`]).
+    pub max_corners: u32,
+    /// Smallest turn, degrees (at least 1).
+    pub min_turn_deg: u32,
+    /// Largest turn, degrees (at most 180).
+    pub max_turn_deg: u32,
+    /// Narrowest corridor, units (at least [`MIN_WIDTH_UNITS`]).
+    pub min_width_units: u32,
+    /// Widest corridor, units (at most [`MAX_WIDTH_UNITS`]).
+    pub max_width_units: u32,
+    /// Shortest leg (its straight part), units (at least [`MIN_LEG_UNITS`]).
+    pub min_leg_units: u32,
+    /// Longest leg, units (at most [`MAX_LEG_UNITS`]).
+    pub max_leg_units: u32,
+    /// Frame rates to choose from, fps (each in [`FPS_RANGE`]).
+    pub fps: Vec<u32>,
+    /// `sv_airaccelerate` values to choose from (each in [`AIRACCELERATE_RANGE`]).
+    pub airaccelerate: Vec<u32>,
+    /// Smallest start speed along the first leg, ups.
+    pub min_start_speed_ups: u32,
+    /// Largest start speed, ups (at most [`MAX_START_SPEED_UPS`]).
+    pub max_start_speed_ups: u32,
+    /// Wall kinds to choose from.
+    pub wall_kinds: Vec<BoundaryKind>,
+    /// Margin between two parts of the corridor that are not neighbours: their centre lines stay
+    /// `width + gap` apart and their walls at least `gap / 2`; also the divider's thickness at a
+    /// 180-degree turn, units (1 to 256).
+    pub wall_gap_units: u32,
+    /// Most corridors drawn for one scene before giving up (at least 1): the settings then leave (almost)
+    /// no corridor that does not overlap itself.
+    pub max_corridor_draws: u32,
+}
+
+impl Default for GeneratorSettings {
+    fn default() -> Self {
+        GeneratorSettings {
+            min_corners: 1,
+            max_corners: 6,
+            min_turn_deg: 30,
+            max_turn_deg: 180,
+            min_width_units: 64,
+            max_width_units: 256,
+            min_leg_units: 200,
+            max_leg_units: 1500,
+            fps: vec![100, 250, 1000],
+            airaccelerate: vec![10, 100],
+            min_start_speed_ups: 0,
+            max_start_speed_ups: 1500,
+            wall_kinds: vec![BoundaryKind::Rule, BoundaryKind::Solid],
+            wall_gap_units: 16,
+            max_corridor_draws: MAX_CORRIDOR_DRAWS,
+        }
+    }
+}
+
+impl GeneratorSettings {
+    /// The family for tests and CI benches: at most 2 turns, legs of at most 800 units, 100 or 250 fps;
+    /// the rest as the default family.
+    pub fn ci_sized() -> Self {
+        GeneratorSettings {
+            max_corners: 2,
+            max_leg_units: 800,
+            fps: vec![100, 250],
+            ..GeneratorSettings::default()
+        }
+    }
+
+    /// Checks every range; the error names the field (`max_corners`) and what is allowed.
+    pub fn validate(&self) -> Result<()> {
+        let range = |name: &str, lo: u32, hi: u32, floor: u32, ceil: u32| -> Result<()> {
+            for (which, v) in [("min", lo), ("max", hi)] {
+                if !(floor..=ceil).contains(&v) {
+                    return Err(Error::invalid(
+                        format!("{which}_{name}"),
+                        f64::from(v),
+                        format!("from {floor} to {ceil}"),
+                    ));
+                }
+            }
+            if lo > hi {
+                return Err(Error::invalid(
+                    format!("min_{name}"),
+                    f64::from(lo),
+                    format!("at most max_{name} ({hi})"),
+                ));
+            }
+            Ok(())
+        };
+        range(
+            "corners",
+            self.min_corners,
+            self.max_corners,
+            1,
+            MAX_CORNERS,
+        )?;
+        range("turn_deg", self.min_turn_deg, self.max_turn_deg, 1, 180)?;
+        range(
+            "width_units",
+            self.min_width_units,
+            self.max_width_units,
+            MIN_WIDTH_UNITS,
+            MAX_WIDTH_UNITS,
+        )?;
+        range(
+            "leg_units",
+            self.min_leg_units,
+            self.max_leg_units,
+            MIN_LEG_UNITS,
+            MAX_LEG_UNITS,
+        )?;
+        range(
+            "start_speed_ups",
+            self.min_start_speed_ups,
+            self.max_start_speed_ups,
+            0,
+            MAX_START_SPEED_UPS,
+        )?;
+        let list = |name: &str, values: &[u32], allowed: &std::ops::RangeInclusive<u32>| {
+            if values.is_empty() {
+                return Err(Error::InvalidValue {
+                    name: name.to_string(),
+                    value: "an empty list".to_string(),
+                    allowed: "at least one value".to_string(),
+                });
+            }
+            match values.iter().find(|v| !allowed.contains(v)) {
+                Some(&v) => Err(Error::invalid(
+                    name,
+                    f64::from(v),
+                    format!("from {} to {}", allowed.start(), allowed.end()),
+                )),
+                None => Ok(()),
+            }
+        };
+        list("fps", &self.fps, &FPS_RANGE)?;
+        list("airaccelerate", &self.airaccelerate, &AIRACCELERATE_RANGE)?;
+        if self.wall_kinds.is_empty() {
+            return Err(Error::InvalidValue {
+                name: "wall_kinds".to_string(),
+                value: "an empty list".to_string(),
+                allowed: "rule, solid or both".to_string(),
+            });
+        }
+        if !(1..=256).contains(&self.wall_gap_units) {
+            return Err(Error::invalid(
+                "wall_gap_units",
+                f64::from(self.wall_gap_units),
+                "from 1 to 256",
+            ));
+        }
+        if self.max_corridor_draws == 0 {
+            return Err(Error::invalid("max_corridor_draws", 0.0, "at least 1"));
+        }
+        Ok(())
+    }
+
+    /// The family in one line (`corners 1-6, turns 30-180 deg, ...`), for files and reports.
+    pub fn describe(&self) -> String {
+        let join = |v: &[u32]| v.iter().map(u32::to_string).collect::<Vec<_>>().join("/");
+        let kinds: Vec<&str> = self.wall_kinds.iter().map(|k| k.name()).collect();
+        format!(
+            "corners {}-{}, turns {}-{} deg, widths {}-{} units, legs {}-{} units, fps {}, \
+             airaccelerate {}, start speeds {}-{} ups, {} walls, wall gap {} units",
+            self.min_corners,
+            self.max_corners,
+            self.min_turn_deg,
+            self.max_turn_deg,
+            self.min_width_units,
+            self.max_width_units,
+            self.min_leg_units,
+            self.max_leg_units,
+            join(&self.fps),
+            join(&self.airaccelerate),
+            self.min_start_speed_ups,
+            self.max_start_speed_ups,
+            kinds.join("/"),
+            self.wall_gap_units,
+        )
+    }
+}
+
+/// One turn of a generated corridor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Turn {
+    /// Angle turned, degrees.
+    pub degrees: u32,
+    /// Which way.
+    pub side: Side,
+}
+
+/// What was drawn for one scene.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Drawn {
+    /// Corridor width, units.
+    pub width_units: u32,
+    /// Straight part of each leg, units, from the start (one more than the turns).
+    pub legs_units: Vec<u32>,
+    /// The turns, from the start.
+    pub turns: Vec<Turn>,
+    /// Frame rate, fps.
+    pub fps: u32,
+    /// `sv_airaccelerate`.
+    pub airaccelerate: u32,
+    /// Start speed along the first leg, ups.
+    pub start_speed_ups: u32,
+    /// Kind of every wall.
+    pub walls: BoundaryKind,
+    /// Corridors drawn until one did not overlap itself (1 when the first did).
+    pub corridor_draws: u32,
+}
+
+/// A generated scene: what was drawn, the centre line, the file's text and the scene read from it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeneratedScene {
+    /// The family's seed.
+    pub seed: u64,
+    /// The item's index in the family.
+    pub index: u64,
+    /// `gen-SEED-INDEX`, the scene's name and file stem.
+    pub name: String,
+    /// What was drawn.
+    pub drawn: Drawn,
+    /// The corridor's centre line, piece by piece (legs and turns alternate).
+    pub centreline: Vec<CentrelinePiece>,
+    /// The scene file's text (TOML, explicit walls), with the seed and the draws in a leading comment.
+    pub toml: String,
+    /// The scene read back from [`GeneratedScene::toml`] and validated.
+    pub scene: Scene,
+}
+
+impl GeneratedScene {
+    /// The file name the scene is written under: `gen-SEED-INDEX.toml`.
+    pub fn file_name(&self) -> String {
+        format!("{}.toml", self.name)
+    }
+}
+
+/// Scene `index` of the family `seed` (see the module documentation). Errors when the settings are out of
+/// range ([`Error::InvalidValue`]) or leave no corridor that does not overlap itself within
+/// [`GeneratorSettings::max_corridor_draws`] ([`Error::Unreachable`]).
+pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<GeneratedScene> {
+    settings.validate()?;
+    let mut rng = SplitMix64::for_item(seed, index);
+    let corners = rng.in_range(settings.min_corners, settings.max_corners);
+    let width_units = rng.in_range(settings.min_width_units, settings.max_width_units);
+    let fps = pick(&mut rng, &settings.fps)?;
+    let airaccelerate = pick(&mut rng, &settings.airaccelerate)?;
+    let start_speed_ups = rng.in_range(settings.min_start_speed_ups, settings.max_start_speed_ups);
+    let walls = pick(&mut rng, &settings.wall_kinds)?;
+    let width = f64::from(width_units);
+    let gap = f64::from(settings.wall_gap_units);
+
+    for draw in 1..=settings.max_corridor_draws {
+        let (turns, legs_units) = draw_corridor(&mut rng, corners, settings);
+        let layout = lay_out(&Shape {
+            width_units: width,
+            gap_units: gap,
+            legs_units: &legs_units,
+            turns: &turns,
+        });
+        if overlaps_itself(&layout.pieces, width, gap) {
+            continue;
+        }
+        let drawn = Drawn {
+            width_units,
+            legs_units,
+            turns: turns
+                .into_iter()
+                .map(|(degrees, side)| Turn { degrees, side })
+                .collect(),
+            fps,
+            airaccelerate,
+            start_speed_ups,
+            walls,
+            corridor_draws: draw,
+        };
+        let name = format!("gen-{seed}-{index}");
+        let toml = scene_text(&name, seed, index, settings, &drawn, &layout);
+        let scene = Scene::from_toml_str(&toml, &format!("{name}.toml"))?;
+        return Ok(GeneratedScene {
+            seed,
+            index,
+            name,
+            drawn,
+            centreline: layout.pieces,
+            toml,
+            scene,
+        });
+    }
+    Err(Error::Unreachable {
+        what: format!(
+            "scene {index} of seed {seed}: no corridor of {corners} turns {width_units} units wide that does \
+             not overlap itself in {} draws; allow longer legs, smaller turns or fewer corners",
+            settings.max_corridor_draws
+        ),
+    })
+}
+
+/// One draw of a corridor: each turn's angle and side, then each leg's length (one more than the turns).
+fn draw_corridor(
+    rng: &mut SplitMix64,
+    corners: u32,
+    settings: &GeneratorSettings,
+) -> (Vec<(u32, Side)>, Vec<u32>) {
+    let turns = (0..corners)
+        .map(|_| {
+            let degrees = rng.in_range(settings.min_turn_deg, settings.max_turn_deg);
+            let side = if rng.coin() { Side::Left } else { Side::Right };
+            (degrees, side)
+        })
+        .collect();
+    let legs = (0..=corners)
+        .map(|_| rng.in_range(settings.min_leg_units, settings.max_leg_units))
+        .collect();
+    (turns, legs)
+}
+
+/// Scenes `0..count` of the family `seed`: the fixed sample tests and benches use.
+pub fn generate_sample(
+    seed: u64,
+    count: u64,
+    settings: &GeneratorSettings,
+) -> Result<Vec<GeneratedScene>> {
+    (0..count).map(|k| generate(seed, k, settings)).collect()
+}
+
+fn pick<T: Copy>(rng: &mut SplitMix64, items: &[T]) -> Result<T> {
+    rng.pick(items).ok_or_else(|| Error::Unreachable {
+        what: "the generator was given an empty list to choose from".to_string(),
+    })
+}
+
+/// A coordinate as written: three decimals, no negative zero.
+fn coordinate(v: f64) -> String {
+    let text = format!("{v:.3}");
+    if text
+        .trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        "0.000".to_string()
+    } else {
+        text
+    }
+}
+
+fn point(p: Vec2) -> String {
+    format!("[{}, {}]", coordinate(p.x), coordinate(p.y))
+}
+
+/// The turns as words: `left 95, right 140`.
+fn turns_text(turns: &[Turn]) -> String {
+    turns
+        .iter()
+        .map(|t| format!("{} {}", t.side.name(), t.degrees))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The file's leading comment: where the scene comes from and everything drawn.
+fn header_comment(seed: u64, index: u64, settings: &GeneratorSettings, d: &Drawn) -> String {
+    let legs: Vec<String> = d.legs_units.iter().map(u32::to_string).collect();
+    let flags = if *settings == GeneratorSettings::default() {
+        ""
+    } else {
+        " and the flags of the family below"
+    };
+    let mut s = String::new();
+    // `write!` to a String cannot fail.
+    let _ = writeln!(
+        s,
+        "# Generated by strafeopt: scene {index} of seed {seed} (`strafeopt gen --seed {seed} --count {}`{flags}),",
+        index + 1
+    );
+    let _ = writeln!(s, "# family: {}.", settings.describe());
+    let _ = writeln!(
+        s,
+        "# Drawn: {} turns (degrees: {}); width {} units; legs {} units (straight parts); {} fps,",
+        d.turns.len(),
+        turns_text(&d.turns),
+        d.width_units,
+        legs.join(", "),
+        d.fps
+    );
+    let _ = writeln!(
+        s,
+        "# sv_airaccelerate {}; start speed {} ups along the first leg; {} walls; corridor draw {}.",
+        d.airaccelerate,
+        d.start_speed_ups,
+        d.walls.name(),
+        d.corridor_draws
+    );
+    s
+}
+
+/// The scene file: the leading comment, then the scene with explicit walls.
+fn scene_text(
+    name: &str,
+    seed: u64,
+    index: u64,
+    settings: &GeneratorSettings,
+    d: &Drawn,
+    layout: &centreline::Layout,
+) -> String {
+    let corners = d.turns.len();
+    let mut s = header_comment(seed, index, settings, d);
+    let _ = writeln!(s, "name = \"{name}\"");
+    let _ = writeln!(
+        s,
+        "description = \"Generated (seed {seed}, scene {index}): GoldSrc, {} fps, sv_airaccelerate {}, airborne at \
+         {} ups; {corners} turns ({}), {} units wide, {} walls\"",
+        d.fps,
+        d.airaccelerate,
+        d.start_speed_ups,
+        turns_text(&d.turns),
+        d.width_units,
+        d.walls.name()
+    );
+    let _ = writeln!(s, "\n[engine]\npreset = \"goldsrc\"\nfps = {}", d.fps);
+    let _ = writeln!(s, "airaccelerate = {}", d.airaccelerate);
+    let _ = writeln!(s, "effects = [\"air-accel\", \"max-velocity\", \"walls\"]");
+    let start = Vec2::new(START_OFFSET_UNITS, 0.0);
+    let velocity = Vec2::new(f64::from(d.start_speed_ups), 0.0);
+    let _ = writeln!(
+        s,
+        "\n[start]\nposition = {}\nvelocity = {}\non-ground = false",
+        point(start),
+        point(velocity)
+    );
+    let (finish_a, finish_b) = match (layout.left.last(), layout.right.last()) {
+        (Some(&a), Some(&b)) => (a, b),
+        _ => (Vec2::ZERO, Vec2::ZERO),
+    };
+    let _ = writeln!(
+        s,
+        "\n[finish]\na = {}\nb = {}",
+        point(finish_a),
+        point(finish_b)
+    );
+    // One polyline: the left wall from the finish back to the start, the start wall, the right wall.
+    let points: Vec<String> = layout
+        .left
+        .iter()
+        .rev()
+        .chain(&layout.right)
+        .map(|&p| point(p))
+        .collect();
+    let _ = writeln!(
+        s,
+        "\n# Left wall from the finish to the start, the start wall, the right wall to the finish.\n[[walls]]\n\
+         kind = \"{}\"\npoints = [\n    {},\n]",
+        d.walls.name(),
+        points.join(",\n    ")
+    );
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_settings_are_the_full_family_and_valid() {
+        let s = GeneratorSettings::default();
+        assert!(s.validate().is_ok());
+        assert_eq!((s.min_corners, s.max_corners), (1, 6));
+        assert_eq!((s.min_turn_deg, s.max_turn_deg), (30, 180));
+        assert_eq!((s.min_width_units, s.max_width_units), (64, 256));
+        assert_eq!((s.min_leg_units, s.max_leg_units), (200, 1500));
+        assert_eq!(s.fps, [100, 250, 1000]);
+        assert_eq!(s.airaccelerate, [10, 100]);
+        assert_eq!((s.min_start_speed_ups, s.max_start_speed_ups), (0, 1500));
+        assert!(GeneratorSettings::ci_sized().validate().is_ok());
+    }
+
+    #[test]
+    fn out_of_range_settings_name_the_field() {
+        let bad = |f: fn(&mut GeneratorSettings)| {
+            let mut s = GeneratorSettings::default();
+            f(&mut s);
+            match s.validate() {
+                Err(Error::InvalidValue { name, .. }) => name,
+                other => panic!("{other:?}"),
+            }
+        };
+        assert_eq!(bad(|s| s.max_corners = 0), "max_corners");
+        assert_eq!(bad(|s| s.min_corners = 7), "min_corners");
+        assert_eq!(bad(|s| s.max_turn_deg = 181), "max_turn_deg");
+        assert_eq!(bad(|s| s.min_width_units = 32), "min_width_units");
+        assert_eq!(bad(|s| s.fps = vec![100, 0]), "fps");
+        assert_eq!(bad(|s| s.airaccelerate.clear()), "airaccelerate");
+        assert_eq!(bad(|s| s.max_start_speed_ups = 2001), "max_start_speed_ups");
+        assert_eq!(bad(|s| s.wall_kinds.clear()), "wall_kinds");
+        assert_eq!(bad(|s| s.wall_gap_units = 0), "wall_gap_units");
+    }
+
+    #[test]
+    fn coordinates_have_three_decimals_and_no_negative_zero() {
+        assert_eq!(coordinate(-0.0001), "0.000");
+        assert_eq!(coordinate(-0.0), "0.000");
+        assert_eq!(coordinate(12.34567), "12.346");
+        assert_eq!(coordinate(-5.0), "-5.000");
+    }
+}
