@@ -51,6 +51,16 @@ pub struct SceneRecord {
     pub solve_seconds: f64,
     /// Solve wall time per frame of the plan, milliseconds.
     pub solve_ms_per_frame: Option<f64>,
+    /// The relaxed certificate's crossing frame and time, seconds.
+    pub relaxed_frames: Option<u64>,
+    /// The relaxed certificate's crossing time, game seconds.
+    pub relaxed_time_s: Option<f64>,
+    /// The spread of the certificate's optimum over its starts, seconds.
+    pub relaxed_spread_s: Option<f64>,
+    /// The plan's time less the relaxed optimum's, frames, for a valid plan.
+    pub rounding_loss_frames: Option<f64>,
+    /// The greedy guide that gave the baseline.
+    pub greedy_guide: String,
     /// `solve`'s status and the plan's source, or the error.
     pub status: String,
 }
@@ -78,6 +88,11 @@ impl SceneRecord {
             gap_pct: None,
             solve_seconds: 0.0,
             solve_ms_per_frame: None,
+            relaxed_frames: None,
+            relaxed_time_s: None,
+            relaxed_spread_s: None,
+            rounding_loss_frames: None,
+            greedy_guide: String::new(),
             status: String::new(),
         }
     }
@@ -127,6 +142,16 @@ pub fn measure_generated_scene(
         .frames
         .filter(|&f| f > 0)
         .map(|f| 1000.0 * r.solve_seconds / f as f64);
+    r.greedy_guide = out.greedy_guide.to_string();
+    if let Some(c) = out.relaxed {
+        r.relaxed_frames = Some(c.frames);
+        r.relaxed_time_s = Some(c.time);
+        r.relaxed_spread_s = Some(c.spread);
+        if r.valid {
+            let tau = g.scene.frame_time_s();
+            r.rounding_loss_frames = r.time_s.map(|t| (t - c.time) / tau);
+        }
+    }
     r.status = format!("{} ({})", out.status, out.source);
     r
 }
@@ -168,6 +193,18 @@ pub fn columns() -> Vec<Column> {
         Column {
             name: "gap to bound (%)",
             value: |r| r.gap_pct,
+        },
+        Column {
+            name: "rounding loss (frames)",
+            value: |r| r.rounding_loss_frames,
+        },
+        Column {
+            name: "plan frame less relaxed frame",
+            value: |r| r.frames.zip(r.relaxed_frames).map(|(p, q)| p as f64 - q as f64),
+        },
+        Column {
+            name: "relaxed spread over starts (ms)",
+            value: |r| r.relaxed_spread_s.map(|s| 1000.0 * s),
         },
         Column {
             name: "solve time per frame (ms)",
