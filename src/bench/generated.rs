@@ -200,7 +200,11 @@ pub fn columns() -> Vec<Column> {
         },
         Column {
             name: "plan frame less relaxed frame",
-            value: |r| r.frames.zip(r.relaxed_frames).map(|(p, q)| p as f64 - q as f64),
+            value: |r| {
+                r.frames
+                    .zip(r.relaxed_frames)
+                    .map(|(p, q)| p as f64 - q as f64)
+            },
         },
         Column {
             name: "relaxed spread over starts (ms)",

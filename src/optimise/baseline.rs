@@ -194,7 +194,9 @@ pub(super) fn baseline(
         }
     };
     // The fastest valid run, else the best-ranked invalid one, and per guide and cap the fastest clean run.
-    let mut valid: Option<(f64, usize, GreedyGuide)> = None;
+    // Per guide and cap, the fastest valid run (the baseline is the fastest of them that is also valid
+    // in the engine-exact mode).
+    let mut valid: Vec<(f64, usize, GreedyGuide)> = Vec::new();
     let mut fallback: Option<((u8, f64), usize, GreedyGuide)> = None;
     let mut clean: Vec<(f64, usize, GreedyGuide)> = Vec::new();
     'sweep: for cap in std::iter::once(None).chain(caps.iter().copied().map(Some)) {
@@ -206,6 +208,7 @@ pub(super) fn baseline(
                 continue;
             }
             let mut best_clean: Option<(f64, usize, GreedyGuide)> = None;
+            let mut best_valid: Option<(f64, usize, GreedyGuide)> = None;
             for &la in &GREEDY_LOOKAHEADS_UNITS {
                 if budget.expired() {
                     break 'sweep;
@@ -225,10 +228,10 @@ pub(super) fn baseline(
                     if run.collisions == 0 && best_clean.as_ref().is_none_or(|b| t < b.0) {
                         best_clean = Some((t, i, guide));
                     }
-                    if valid.as_ref().is_none_or(|b| t < b.0) {
-                        valid = Some((t, i, guide));
+                    if best_valid.as_ref().is_none_or(|b| t < b.0) {
+                        best_valid = Some((t, i, guide));
                     }
-                } else if valid.is_none() {
+                } else if valid.is_empty() && best_valid.is_none() {
                     let r = match run.crossing {
                         Some(c) => (1, c.time),
                         None => (2, -Greedy::new(g.path.clone(), 0.0).project(run.end_pos)),
@@ -239,8 +242,10 @@ pub(super) fn baseline(
                 }
             }
             clean.extend(best_clean);
+            valid.extend(best_valid);
         }
     }
+    valid.sort_by(|a, b| a.0.total_cmp(&b.0));
     clean.sort_by(|a, b| a.0.total_cmp(&b.0));
     clean.truncate(MAX_STARTS);
     // The kept runs, played again whole.
@@ -248,14 +253,23 @@ pub(super) fn baseline(
         guide,
         trace: sim.run(&mut strafer(&guides[i].path, &guide)),
     };
-    // An invalid run kept is replayed within the budget: it may never end before the frame cap.
-    let greedy = match (valid, fallback) {
-        (Some((_, i, guide)), _) => replay(i, guide),
-        (None, Some((_, i, guide))) => GuideRun {
+    // The fastest valid run whose engine-exact replay is valid too (the f64 run may graze a wall the
+    // game's f32 arithmetic touches), else the fastest valid one. An invalid run kept is replayed within
+    // the budget: it may never end before the frame cap.
+    let engine_valid = valid.iter().find_map(|&(_, i, guide)| {
+        let run = replay(i, guide);
+        sim.run_engine_exact_within(&run.trace.controls, budget)
+            .feasible()
+            .then_some(run)
+    });
+    let greedy = match (engine_valid, valid.first(), fallback) {
+        (Some(run), _, _) => run,
+        (None, Some(&(_, i, guide)), _) => replay(i, guide),
+        (None, None, Some((_, i, guide))) => GuideRun {
             guide,
             trace: sim.run_within(&mut strafer(&guides[i].path, &guide), budget),
         },
-        (None, None) => {
+        (None, None, None) => {
             let guide = GreedyGuide {
                 clearance_units: 0.0,
                 centre_line: false,
