@@ -315,6 +315,11 @@ mod tests {
             gap_pct: Some(1.0),
             solve_seconds: seconds,
             solve_ms_per_frame: Some(10.0 * seconds),
+            relaxed_frames: None,
+            relaxed_time_s: None,
+            relaxed_spread_s: None,
+            rounding_loss_frames: None,
+            greedy_guide: String::new(),
             status: String::new(),
         };
         let records = [rec(Some(3), 1.0), rec(None, 2.0), rec(Some(9), 3.0)];
