@@ -112,6 +112,15 @@ fn closest_parameter(p: Vec2, a: Vec2, e: Vec2) -> f64 {
     (p - a).dot(e) / len2
 }
 
+/// How far the grown walls are shrunk when the reachable stretches of the target are found, units: not
+/// at all, where visibility shrinks them by [`PATH_SHRINK_UNITS`]. A stretch's end then lies just outside
+/// every wall the visibility test knows, so a last leg that runs along a grown wall to the end of a stretch
+/// (the finish line leaving the wall at its corner) is not blocked by rounding at its very end; shrunk
+/// alike, the end lay on the shrunk wall and the path went round the wall's far corner and back, longer
+/// than the true shortest path and so no longer a lower bound. Unshrunk, the stretches are exactly where
+/// the hull may touch the line.
+const STRETCH_SHRINK_UNITS: f64 = 0.0;
+
 /// The parts of the segment `(a, b)` outside every (shrunk) grown wall, as closed parameter intervals
 /// `[s0, s1]` of `a + s (b - a)`.
 fn reachable_stretches(obstacles: &[&GrownSegment], (a, b): (Vec2, Vec2)) -> Vec<(f64, f64)> {
@@ -132,7 +141,7 @@ fn reachable_stretches(obstacles: &[&GrownSegment], (a, b): (Vec2, Vec2)) -> Vec
     // Open intervals of the parameter in (0, 1) covered by grown walls.
     let mut covered: Vec<(f64, f64)> = obstacles
         .iter()
-        .filter_map(|g| g.open_interval(a, e, PATH_SHRINK_UNITS))
+        .filter_map(|g| g.open_interval(a, e, STRETCH_SHRINK_UNITS))
         .filter(|iv| iv.meets_unit_open())
         .map(|iv| (iv.lo.max(0.0), iv.hi.min(1.0)))
         .collect();
