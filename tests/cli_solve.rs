@@ -47,6 +47,31 @@ fn json_carries_every_documented_key() {
     assert_eq!(v["quality"], "fast");
     assert_eq!(v["feasible"], true);
     assert_eq!(v["engine_exact"]["feasible"], true);
+    // The certificate, the rounding loss it gives and the greedy guide that won.
+    for k in ["frames", "time", "starts", "reached", "spread"] {
+        assert!(v["relaxed"].get(k).is_some(), "missing relaxed.{k}");
+    }
+    let (plan, relaxed) = (
+        v["time"].as_f64().unwrap_or(f64::NAN),
+        v["relaxed"]["time"].as_f64().unwrap_or(f64::NAN),
+    );
+    let loss = v["rounding_loss_frames"].as_f64().unwrap_or(f64::NAN);
+    assert!(
+        (loss - (plan - relaxed) / 0.01).abs() < 1e-6,
+        "{loss} vs {plan} - {relaxed}"
+    );
+    assert!(relaxed <= plan && relaxed >= v["lower_bound"]["time"].as_f64().unwrap_or(f64::NAN));
+    for k in [
+        "clearance_units",
+        "centre_line",
+        "lookahead_units",
+        "speed_cap_ups",
+    ] {
+        assert!(
+            v["greedy"]["guide"].get(k).is_some(),
+            "missing greedy.guide.{k}"
+        );
+    }
     let (t, g, lb) = (
         v["time"].as_f64().unwrap_or(f64::NAN),
         v["greedy"]["time"].as_f64().unwrap_or(f64::NAN),

@@ -6,7 +6,7 @@
 //! certificate lies between the bound and the plan.
 
 use strafeopt::optimise::{solve, Quality, SearchSettings};
-use strafeopt::scene::generate::{generate_sample, GeneratorSettings};
+use strafeopt::scene::generate::{generate_sample, GeneratedScene, GeneratorSettings};
 
 /// The sample: scenes 0 to [`SAMPLE_COUNT`] - 1 of this seed of the CI-sized family.
 const SAMPLE_SEED: u64 = 2026;
@@ -18,60 +18,36 @@ fn the_generated_family_is_solved_validly_never_slower_than_greedy_nor_below_the
     let sample = generate_sample(SAMPLE_SEED, SAMPLE_COUNT, &GeneratorSettings::ci_sized())
         .unwrap_or_else(|e| panic!("{e}"));
     let settings = SearchSettings::for_quality(Quality::Fast);
-    let mut report = Vec::new();
-    let mut losses = Vec::new();
-    for g in &sample {
-        let name = &g.name;
-        let o = solve(&g.scene, &settings).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let plan = o
-            .trace
-            .crossing
-            .unwrap_or_else(|| panic!("{name}: the plan does not cross"));
-        assert!(o.trace.feasible(), "{name}: the plan breaks a rule");
-        let ee = o.engine_exact.crossing.map(|c| c.frames);
-        assert!(
-            o.engine_exact.feasible() && ee == Some(plan.frames),
-            "{name}: engine-exact {ee:?} against the plan's frame {}",
-            plan.frames
-        );
-        if let Some(greedy) = o.greedy.crossing.filter(|_| o.greedy.feasible()) {
-            assert!(
-                plan.time <= greedy.time + 1e-12,
-                "{name}: plan {plan:?} slower than greedy {greedy:?}"
-            );
-        }
-        let bound = o.bound.crossing.time;
-        assert!(
-            plan.time >= bound - 1e-12,
-            "{name}: plan {plan:?} below the bound {bound}"
-        );
-        if let Some(r) = o.relaxed {
-            assert!(
-                r.time >= bound - 1e-9,
-                "{name}: relaxed {r:?} below the bound {bound}"
-            );
-            // The plan is the certificate's last start: the certificate is never behind it (to the
-            // quantisation of the plan's yaws, a few thousandths of a frame).
-            let tau = g.scene.frame_time_s();
-            assert!(
-                r.time <= plan.time + 0.01 * tau,
-                "{name}: relaxed {r:?} after the plan {plan:?}"
-            );
-            losses.push((plan.time - r.time) / tau);
-        }
-        report.push(format!(
-            "{name}: plan {} ({:.6} s), greedy {:?}, bound {}, relaxed {:?}, {}",
-            plan.frames,
-            plan.time,
-            o.greedy
-                .crossing
-                .filter(|_| o.greedy.feasible())
-                .map(|c| c.frames),
-            o.bound.crossing.frames,
-            o.relaxed.map(|r| r.frames),
-            o.greedy_guide
-        ));
-    }
+    // Solved on as many threads as the machine has cores; each scene's checks are its own.
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<(usize, String, Option<f64>)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(g) = sample.get(k) else { break };
+                        let (line, loss) = checked(g, &settings);
+                        done.push((k, line, loss));
+                    }
+                    done
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| panic!("a scene's checks failed"))
+            })
+            .collect()
+    });
+    let mut results = results;
+    results.sort_by_key(|r| r.0);
+    let report: Vec<String> = results.iter().map(|r| r.1.clone()).collect();
+    let losses: Vec<f64> = results.iter().filter_map(|r| r.2).collect();
     eprintln!("{}", report.join("\n"));
     // Most scenes are planned: the certificate exists wherever the optimiser's plan won.
     assert!(
@@ -80,4 +56,61 @@ fn the_generated_family_is_solved_validly_never_slower_than_greedy_nor_below_the
         losses.len(),
         sample.len()
     );
+}
+
+/// Solves `g` and checks it; returns a line for the report and the rounding loss in frames, if the
+/// certificate exists.
+fn checked(g: &GeneratedScene, settings: &SearchSettings) -> (String, Option<f64>) {
+    let name = &g.name;
+    let o = solve(&g.scene, settings).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let plan = o
+        .trace
+        .crossing
+        .unwrap_or_else(|| panic!("{name}: the plan does not cross"));
+    assert!(o.trace.feasible(), "{name}: the plan breaks a rule");
+    let ee = o.engine_exact.crossing.map(|c| c.frames);
+    assert!(
+        o.engine_exact.feasible() && ee == Some(plan.frames),
+        "{name}: engine-exact {ee:?} against the plan's frame {}",
+        plan.frames
+    );
+    if let Some(greedy) = o.greedy.crossing.filter(|_| o.greedy.feasible()) {
+        assert!(
+            plan.time <= greedy.time + 1e-12,
+            "{name}: plan {plan:?} slower than greedy {greedy:?}"
+        );
+    }
+    let bound = o.bound.crossing.time;
+    assert!(
+        plan.time >= bound - 1e-12,
+        "{name}: plan {plan:?} below the bound {bound}"
+    );
+    let mut loss = None;
+    if let Some(r) = o.relaxed {
+        assert!(
+            r.time >= bound - 1e-9,
+            "{name}: relaxed {r:?} below the bound {bound}"
+        );
+        // The plan is the certificate's last start: the certificate is never behind it (to the
+        // quantisation of the plan's yaws, a few thousandths of a frame).
+        let tau = g.scene.frame_time_s();
+        assert!(
+            r.time <= plan.time + 0.01 * tau,
+            "{name}: relaxed {r:?} after the plan {plan:?}"
+        );
+        loss = Some((plan.time - r.time) / tau);
+    }
+    let line = format!(
+        "{name}: plan {} ({:.6} s), greedy {:?}, bound {}, relaxed {:?}, {}",
+        plan.frames,
+        plan.time,
+        o.greedy
+            .crossing
+            .filter(|_| o.greedy.feasible())
+            .map(|c| c.frames),
+        o.bound.crossing.frames,
+        o.relaxed.map(|r| r.frames),
+        o.greedy_guide
+    );
+    (line, loss)
 }

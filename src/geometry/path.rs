@@ -112,14 +112,14 @@ fn closest_parameter(p: Vec2, a: Vec2, e: Vec2) -> f64 {
     (p - a).dot(e) / len2
 }
 
-/// How far the grown walls are shrunk when the reachable stretches of the target are found, units: not
-/// at all, where visibility shrinks them by [`PATH_SHRINK_UNITS`]. A stretch's end then lies just outside
-/// every wall the visibility test knows, so a last leg that runs along a grown wall to the end of a stretch
-/// (the finish line leaving the wall at its corner) is not blocked by rounding at its very end; shrunk
+/// How far the grown walls are shrunk when the reachable stretches of the target are found, units: half
+/// as far as visibility shrinks them ([`PATH_SHRINK_UNITS`]). A stretch's end then lies just outside every
+/// wall the visibility test knows, so a last leg that runs along a grown wall to the end of a stretch (the
+/// finish line leaving the wall at a slanted corner) is not blocked by rounding at its very end; shrunk
 /// alike, the end lay on the shrunk wall and the path went round the wall's far corner and back, longer
-/// than the true shortest path and so no longer a lower bound. Unshrunk, the stretches are exactly where
-/// the hull may touch the line.
-const STRETCH_SHRINK_UNITS: f64 = 0.0;
+/// than the true shortest path and so no longer a lower bound. Some shrink is kept so that a corridor
+/// exactly one hull wide still has its single point on the line.
+const STRETCH_SHRINK_UNITS: f64 = 0.5 * PATH_SHRINK_UNITS;
 
 /// The parts of the segment `(a, b)` outside every (shrunk) grown wall, as closed parameter intervals
 /// `[s0, s1]` of `a + s (b - a)`.
