@@ -208,17 +208,7 @@ pub fn measure_scene(
     let mut rows = Vec::new();
     let t = Instant::now();
     let bound = lower_bound(scene, &scene.corridor()?)?;
-    if bound.crossing.frames > settings.max_frames {
-        return Err(Error::FrameLimit {
-            scene: scene.origin.clone(),
-            frames: bound.crossing.frames,
-            limit: settings.max_frames,
-        });
-    }
-    let scene = &Scene {
-        max_frames: scene.max_frames.min(settings.max_frames),
-        ..scene.clone()
-    };
+    let scene = &crate::optimise::bound::frame_limited_scene(scene, &bound, settings.max_frames)?;
     let sim = Simulation::new(scene)?;
     let corner = bend_width_units.and_then(|w| corner_speed_ups(scene, w));
     let bt = bound.crossing.time;

@@ -209,6 +209,8 @@ pub(super) fn baseline(
             }
             let mut best_clean: Option<(f64, usize, GreedyGuide)> = None;
             let mut best_valid: Option<(f64, usize, GreedyGuide)> = None;
+            // Ranks how far along this guide an unfinished run got.
+            let along = Greedy::new(g.path.clone(), 0.0);
             for &la in &GREEDY_LOOKAHEADS_UNITS {
                 if budget.expired() {
                     break 'sweep;
@@ -234,7 +236,7 @@ pub(super) fn baseline(
                 } else if valid.is_empty() && best_valid.is_none() {
                     let r = match run.crossing {
                         Some(c) => (1, c.time),
-                        None => (2, -Greedy::new(g.path.clone(), 0.0).project(run.end_pos)),
+                        None => (2, -along.project(run.end_pos)),
                     };
                     if fallback.as_ref().is_none_or(|b| r < b.0) {
                         fallback = Some((r, i, guide));

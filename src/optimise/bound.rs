@@ -607,6 +607,23 @@ pub struct LowerBound {
     pub crossing: Crossing,
 }
 
+/// `scene` with its frame cap lowered to `max_frames`, after checking that the bound's crossing fits under
+/// it: [`Error::FrameLimit`] names the frames needed and the limit. No run then goes past the limit: the
+/// memory of a run (and of every stage after it) grows with its frames.
+pub fn frame_limited_scene(scene: &Scene, bound: &LowerBound, max_frames: u64) -> Result<Scene> {
+    if bound.crossing.frames > max_frames {
+        return Err(Error::FrameLimit {
+            scene: scene.origin.clone(),
+            frames: bound.crossing.frames,
+            limit: max_frames,
+        });
+    }
+    Ok(Scene {
+        max_frames: scene.max_frames.min(max_frames),
+        ..scene.clone()
+    })
+}
+
 /// The lower bound of `scene` through `corridor` (docs/physics.md section 6). For a `hull` finish the centre
 /// need only come within the box of the line, at most `16 sqrt 2` units short of it, so that much is
 /// taken off the path. Errors with [`Error::NoValidPath`] when no path reaches the finish.

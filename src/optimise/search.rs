@@ -14,7 +14,7 @@
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
 use super::baseline::{baseline, corner_caps, GreedyGuide, GuideRun};
-use super::bound::lower_bound_within;
+use super::bound::{frame_limited_scene, lower_bound_within};
 use super::model::FrameControl;
 use super::planner::Planner;
 use super::polish::rounded_and_polished;
@@ -418,19 +418,7 @@ fn solve_once(
 ) -> Result<Outcome> {
     let started = Instant::now();
     let bound = lower_bound_within(scene, &scene.corridor()?, &budget)?;
-    if bound.crossing.frames > settings.max_frames {
-        return Err(Error::FrameLimit {
-            scene: scene.origin.clone(),
-            frames: bound.crossing.frames,
-            limit: settings.max_frames,
-        });
-    }
-    // No run goes past the frame limit: the memory of a run (and of every stage after it) grows with its
-    // frames.
-    let scene = &Scene {
-        max_frames: scene.max_frames.min(settings.max_frames),
-        ..scene.clone()
-    };
+    let scene = &frame_limited_scene(scene, &bound, settings.max_frames)?;
     let sim = Simulation::new(scene)?;
     if budget.expired() {
         return Err(Error::stopped(budget.stop(), Stage::LowerBound));
