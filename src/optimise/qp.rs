@@ -103,6 +103,11 @@ impl SubStep {
     }
 }
 
+/// Clarabel's duality gap tolerance (absolute and relative) on a sub-problem.
+const SUBPROBLEM_GAP_TOL: f64 = 1e-6;
+/// Clarabel's feasibility tolerance on a sub-problem.
+const SUBPROBLEM_FEAS_TOL: f64 = 1e-7;
+
 /// Interior-point iterations Clarabel may take on one sub-problem.
 pub const MAX_SUBPROBLEM_ITERATIONS: u32 = 200;
 
@@ -279,6 +284,14 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         // Ruiz equilibration off: on these sub-problems it doubled Clarabel's interior-point iterations
         // (about 40 against 20 on the 100 fps bend) and the solve time, for no better steps.
         .equilibrate_enable(false)
+        // A sub-problem is one step of the SCP, linearised again at the next iteration: the step needs
+        // the accuracy of the trust region, not of the last digit. Iterative refinement (up to 10 extra
+        // KKT solves per interior-point iteration) and gap tolerances of 1e-8 more than doubled the time
+        // of a sub-problem for steps no better (docs/design.md, "What a sub-problem costs").
+        .iterative_refinement_enable(false)
+        .tol_gap_abs(SUBPROBLEM_GAP_TOL)
+        .tol_gap_rel(SUBPROBLEM_GAP_TOL)
+        .tol_feas(SUBPROBLEM_FEAS_TOL)
         .build()
     {
         Ok(s) => s,

@@ -298,6 +298,11 @@ impl Certifier {
         self.best.as_ref()
     }
 
+    /// The crossing time of the fastest relaxed plan so far, seconds.
+    pub(super) fn best_time(&self) -> Option<f64> {
+        self.best.as_ref().map(|b| b.crossing.time)
+    }
+
     /// The certificate, if any start reached the line.
     pub(super) fn certificate(&self) -> Option<RelaxedCertificate> {
         let best = self.best.as_ref()?;

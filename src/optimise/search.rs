@@ -476,28 +476,32 @@ fn solve_once(
         progress,
     );
     progress(Progress::Finishing);
-    // Stages 3 and 4, first with the settings' final margin; if no plan stays valid through rounding and
-    // quantisation (a tight margin along a long wall), again with wider ones.
+    // Stages 3 and 4 for each relaxed line, first with the settings' final margin; if no plan of the line
+    // stays valid through rounding and quantisation (a tight margin along a long wall), again with wider
+    // ones.
     let mut best: Option<(f64, Trace, Vec<FrameControl>)> = None;
-    for final_margin in FINAL_MARGIN_FACTORS.map(|f| f * settings.margin_units) {
-        for (relaxed, margin) in &sources {
-            let candidates = rounded_and_polished(&mut planner, relaxed, *margin, final_margin);
-            for plan in candidates {
+    for (relaxed, margin) in &sources {
+        for final_margin in FINAL_MARGIN_FACTORS.map(|f| f * settings.margin_units) {
+            let mut valid = false;
+            for plan in rounded_and_polished(&mut planner, relaxed, *margin, final_margin) {
                 if let Some((t, trace)) = quantised_and_verified(&mut planner, plan.clone()) {
+                    valid = true;
                     let limit = best.as_ref().map_or(time_of(greedy), |b| b.0);
                     if t < limit {
                         best = Some((t, trace, plan));
                     }
                 }
             }
-        }
-        if best.is_some() || planner.timed_out {
-            break;
+            if valid || planner.timed_out {
+                break;
+            }
         }
     }
-    // The final plan is a point of the certificate's problem too: the last start, so that the certificate
-    // is never behind the plan where the relaxed stage stopped short of its optimum.
-    if let Some((_, _, plan)) = &best {
+    // The final plan is a point of the certificate's problem too: where it is faster than the certificate
+    // (the relaxed stage stopped short of its optimum), it is the last start, so that the certificate is
+    // never behind the plan.
+    let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
+    if let Some((_, _, plan)) = best.as_ref().filter(|b| behind(b.0)) {
         certifier.add_start(&mut planner, progress, plan.clone(), StartKind::Planned, lo);
     }
     let stats = planner.stats;
