@@ -11,7 +11,7 @@
 use super::LowerBound;
 use crate::budget::Budget;
 use crate::geometry::{Corridor, HULL_HALF_WIDTH_UNITS};
-use crate::physics::curvature::{bend_arc_radius, speed_for_radius};
+use crate::physics::curvature::{bend_arc_radius, speed_for_radius, turn_arc_radius};
 use crate::physics::Vec2;
 use crate::scene::Scene;
 use crate::sim::controllers::{Greedy, GREEDY_LOOKAHEADS_UNITS};
@@ -94,13 +94,46 @@ impl Baseline {
 }
 
 /// Speed caps from the radius-speed relation (docs/physics.md section 9): the speeds whose measured turn
-/// radius fits the largest arc through bends of [`CAP_WIDTHS_UNITS`] for the hull centre. Capped greedy
-/// runs seed corner lines the uncapped strafer overshoots.
-pub(super) fn corner_caps(scene: &Scene) -> Vec<f64> {
-    CAP_WIDTHS_UNITS
+/// radius fits the largest arc through bends of [`CAP_WIDTHS_UNITS`] for the hull centre, at 90 degrees
+/// and, where the guide `path` has a sharper corner, at its sharpest. Capped greedy runs seed corner lines
+/// the uncapped strafer overshoots.
+pub(super) fn corner_caps(scene: &Scene, path: &[Vec2]) -> Vec<f64> {
+    let sharpest = sharpest_corner_rad(path);
+    let mut radii: Vec<f64> = CAP_WIDTHS_UNITS
         .iter()
-        .filter_map(|&w| speed_for_radius(&scene.vars, bend_arc_radius(w)).ok())
+        .map(|&w| bend_arc_radius(w))
+        .collect();
+    if sharpest > std::f64::consts::FRAC_PI_2 {
+        radii.extend(
+            CAP_WIDTHS_UNITS
+                .iter()
+                .map(|&w| turn_arc_radius(w, sharpest)),
+        );
+    }
+    radii.sort_by(f64::total_cmp);
+    radii
+        .iter()
+        .filter_map(|&r| speed_for_radius(&scene.vars, r).ok())
         .collect()
+}
+
+/// Path vertices closer than this, units, turn the same corner of the corridor (a corner drawn with
+/// several points is wrapped by several vertices).
+const CORNER_SPAN_UNITS: f64 = 64.0;
+
+/// The largest turn of the polyline `path` at one corner, radians: the turns of consecutive vertices
+/// that bend the same way within [`CORNER_SPAN_UNITS`] of each other, summed.
+fn sharpest_corner_rad(path: &[Vec2]) -> f64 {
+    let mut sharpest: f64 = 0.0;
+    let mut current = 0.0;
+    for w in path.windows(3) {
+        let (a, b) = (w[1] - w[0], w[2] - w[1]);
+        let turn = a.cross(b).atan2(a.dot(b));
+        let joined = current * turn > 0.0 && a.length() < CORNER_SPAN_UNITS;
+        current = if joined { current + turn } else { turn };
+        sharpest = sharpest.max(current.abs());
+    }
+    sharpest
 }
 
 /// A guide path: the shortest path of a body `clearance_units` wider than the hull on either side.
@@ -182,7 +215,7 @@ pub(super) fn baseline(
 ) -> Baseline {
     let guides = guide_paths(scene, bound);
     let caps = if scene.effects.is_air_only() {
-        corner_caps(scene)
+        corner_caps(scene, &bound.path)
     } else {
         Vec::new()
     };
@@ -221,7 +254,8 @@ pub(super) fn baseline(
                     lookahead_units: la,
                     speed_cap_ups: cap,
                 };
-                let run = sim.run_summary(&mut strafer(&g.path, &guide), budget);
+                // An invalid run counts only by how far it got: it is not played past its first broken rule.
+                let run = sim.run_summary_until_broken(&mut strafer(&g.path, &guide), budget);
                 let t = match (run.feasible(), run.crossing) {
                     (true, Some(c)) => c.time,
                     _ => f64::INFINITY,
@@ -295,4 +329,29 @@ pub(super) fn baseline(
 /// A run the planning model can follow: valid, finished, and touching no wall.
 fn is_clean(t: &Trace) -> bool {
     t.feasible() && t.crossing.is_some() && t.collisions() == 0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_corner_wrapped_by_several_vertices_counts_as_one_turn() {
+        // A 150-degree left turn drawn as three 50-degree bends 10 units apart, then, 500 units on, a
+        // 60-degree right turn.
+        let mut path = vec![Vec2::new(-500.0, 0.0), Vec2::new(0.0, 0.0)];
+        let mut heading: f64 = 0.0;
+        for _ in 0..3 {
+            heading += 50f64.to_radians();
+            let last = path[path.len() - 1];
+            path.push(last + Vec2::from_angle(heading) * 10.0);
+        }
+        let last = path[path.len() - 1];
+        path.push(last + Vec2::from_angle(heading) * 500.0);
+        heading -= 60f64.to_radians();
+        let last = path[path.len() - 1];
+        path.push(last + Vec2::from_angle(heading) * 500.0);
+        let sharpest = sharpest_corner_rad(&path);
+        assert!((sharpest - 150f64.to_radians()).abs() < 1e-9, "{sharpest}");
+    }
 }

@@ -602,7 +602,7 @@ fn plan_jumping_scene(finisher: &Finisher, settings: &SearchSettings, budget: Bu
     let planned = super::jumps::plan_jumps(finisher.sim, settings, budget)
         .map(|p| (p.best.trace, p.evaluations, p.timed_out))
         .or_else(|| {
-            let caps = corner_caps(scene);
+            let caps = corner_caps(scene, path);
             super::hops::plan_hops(finisher.sim, path, &caps, settings, budget)
                 .map(|p| (p.best.trace, p.evaluations, p.timed_out))
         });

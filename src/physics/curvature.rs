@@ -21,6 +21,18 @@ pub fn bend_arc_radius(width_for_centre: f64) -> f64 {
     (2.0 + std::f64::consts::SQRT_2) * width_for_centre
 }
 
+/// Largest arc through a bend that turns the path by `turn_rad` (0 to pi), of equal width `d` before and
+/// after, touching both outer walls and the inner corner: `r = d / (1 - cos(turn / 2))` (docs/physics.md
+/// section 9; `(2 + sqrt 2) d` at 90 degrees, `d` for a U-turn). Infinite for no turn.
+pub fn turn_arc_radius(width_for_centre: f64, turn_rad: f64) -> f64 {
+    let room = 1.0 - (0.5 * turn_rad.clamp(0.0, std::f64::consts::PI)).cos();
+    if room > 0.0 {
+        width_for_centre / room
+    } else {
+        f64::INFINITY
+    }
+}
+
 /// The source text's radius of the path over one frame (docs/physics.md section 9):
 /// `r = (tau / sin theta)(2|v|^2/mu + 3|v| cos theta + mu)`. Infinite when `sin theta` or `mu` is zero.
 pub fn radius_source_text(speed: f64, cos_theta: f64, mu: f64, tau_s: f64) -> f64 {
@@ -207,4 +219,19 @@ fn invert_rising_branch(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Resu
         }
     }
     Ok(0.5 * (lo + hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn the_turn_arc_is_the_bend_arc_at_90_degrees_and_the_width_for_a_u_turn() {
+        assert!((turn_arc_radius(48.0, FRAC_PI_2) - bend_arc_radius(48.0)).abs() < 1e-9);
+        assert!((turn_arc_radius(48.0, PI) - 48.0).abs() < 1e-9);
+        // Sharper turns leave smaller arcs; no turn leaves any.
+        assert!(turn_arc_radius(48.0, 2.5) < turn_arc_radius(48.0, 2.0));
+        assert!(turn_arc_radius(48.0, 0.0).is_infinite());
+    }
 }

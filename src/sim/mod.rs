@@ -220,6 +220,26 @@ impl<'s> Simulation<'s> {
     /// memory that does not grow with the run's length, for sweeps that keep only their best run (and
     /// replay it with [`Self::run`]).
     pub fn run_summary(&self, controller: &mut dyn Controller, budget: &Budget) -> RunSummary {
+        self.summarise(controller, budget, false)
+    }
+
+    /// [`Self::run_summary`] that stops at the first frame breaking a rule: the run is invalid from there
+    /// on, and a sweep that ranks invalid runs only by how far they got need not play the rest (an invalid
+    /// run may wander until the frame cap).
+    pub fn run_summary_until_broken(
+        &self,
+        controller: &mut dyn Controller,
+        budget: &Budget,
+    ) -> RunSummary {
+        self.summarise(controller, budget, true)
+    }
+
+    fn summarise(
+        &self,
+        controller: &mut dyn Controller,
+        budget: &Budget,
+        stop_on_broken_rule: bool,
+    ) -> RunSummary {
         let tau = self.stepper.frame_time_s();
         let mut s = self.scene.start;
         let mut summary = RunSummary {
@@ -246,6 +266,9 @@ impl<'s> Simulation<'s> {
             summary.end_pos = s.pos;
             summary.collisions += out.contacts;
             summary.broke_rule |= out.broke_rule;
+            if stop_on_broken_rule && summary.broke_rule {
+                break;
+            }
             if let Some(f) = self.scene.finish.crossing_fraction(out.from, s.pos) {
                 summary.crossing = Some(Crossing::new(frame, f, tau));
                 break;
