@@ -11,8 +11,8 @@ use common::strafeopt_in;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use strafeopt::geometry::BoundaryKind;
-use strafeopt::physics::Effect;
 use strafeopt::physics::Vec2;
+use strafeopt::physics::{Effect, Preset};
 use strafeopt::scene::generate::{
     generate, generate_sample, CentrelinePiece, GeneratedScene, GeneratorSettings, SceneKind, Side,
 };
@@ -132,8 +132,23 @@ fn assert_matches_drawn(g: &GeneratedScene) {
             Effect::GroundAccel,
             Effect::Walls,
         ],
+        SceneKind::Hl2 => &[
+            Effect::Gravity,
+            Effect::Jump,
+            Effect::Friction,
+            Effect::MaxVelocity,
+            Effect::AirAccel,
+            Effect::GroundAccel,
+            Effect::Walls,
+        ],
     };
     assert_eq!(s.effects.list(), want, "{name}");
+    let preset = if d.kind == SceneKind::Hl2 {
+        Preset::SourceHl2
+    } else {
+        Preset::GoldSrc
+    };
+    assert_eq!(s.preset, preset, "{name}");
     assert!(
         (s.start.vel.x - f64::from(d.start_speed_ups)).abs() < 1e-9,
         "{name}"
@@ -280,17 +295,17 @@ fn all_kinds() -> GeneratorSettings {
 }
 
 #[test]
-fn ground_and_bhop_scenes_are_valid_and_cover_their_start_speeds() {
+fn ground_bhop_and_hl2_scenes_are_valid_and_cover_their_start_speeds() {
     let settings = all_kinds();
-    let scenes = sample(&settings, 300);
+    let scenes = sample(&settings, 400);
     for g in &scenes {
         assert_valid(g, f64::from(settings.wall_gap_units));
         assert_matches_drawn(g);
     }
     let count = |k: SceneKind| scenes.iter().filter(|g| g.drawn.kind == k).count();
-    // Each kind about a third of 300 (a binomial's 5 sigma is 41).
+    // Each kind about a quarter of 400 (a binomial's 5 sigma is 43).
     for k in SceneKind::ALL {
-        assert!((60..=140).contains(&count(k)), "{k:?}: {}", count(k));
+        assert!((57..=143).contains(&count(k)), "{k:?}: {}", count(k));
     }
     let ground: Vec<u32> = scenes
         .iter()
@@ -320,6 +335,7 @@ fn ground_and_bhop_scenes_are_valid_and_cover_their_start_speeds() {
             SceneKind::Air => "airborne at",
             SceneKind::Ground => "groundstrafing from",
             SceneKind::Bhop => "bunnyhopping from the ground at",
+            SceneKind::Hl2 => "Half-Life 2, ",
         };
         assert!(g.scene.description.contains(words), "{}", g.toml);
         assert_eq!(

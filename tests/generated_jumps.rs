@@ -1,22 +1,24 @@
 //! `solve` on generated scenes that start on the ground: a fixed sample of the generated family's
-//! groundstrafing and bunnyhopping kinds (`strafeopt gen --kinds ground,bhop`, [`jump_family`]), at
-//! `fast`. For every scene: the plan is valid in f64 and in the engine-exact mode at the same frame, never
-//! slower than the strongest greedy run, never before the lower bound; a groundstrafing plan never leaves
-//! the ground and a bunnyhopping plan jumps. One scene is solved twice to the same controls.
+//! groundstrafing, bunnyhopping and Half-Life 2 kinds (`strafeopt gen --kinds ground,bhop,hl2`,
+//! [`jump_family`]), at `fast`. For every scene: the plan is valid in f64 and in the engine-exact mode at
+//! the same frame, never slower than the strongest greedy run, never before the lower bound; a
+//! groundstrafing plan never leaves the ground and a jumping plan is airborne exactly when it jumps. Most
+//! bunnyhop plans jump and beat greedy. One scene is solved twice to the same controls.
 
 use strafeopt::optimise::{solve, Outcome, Quality, SearchSettings};
 use strafeopt::scene::generate::{generate_sample, GeneratedScene, GeneratorSettings, SceneKind};
 
 /// The sample: scenes 0 to [`SAMPLE_COUNT`] - 1 of this seed of [`jump_family`].
 const SAMPLE_SEED: u64 = 2027;
-/// At least 8 scenes of the two kinds, within the CI budget at `fast` (each solves in about a second).
-const SAMPLE_COUNT: u64 = 16;
+/// At least 8 scenes of the kinds that start on the ground, within the CI budget at `fast` (each solves
+/// in about a second).
+const SAMPLE_COUNT: u64 = 18;
 
-/// The CI-sized family (1 or 2 turns, legs up to 800 units, 100 or 250 fps) with the two kinds that
-/// start on the ground.
+/// The CI-sized family (1 or 2 turns, legs up to 800 units, 100 or 250 fps) with the kinds that start on
+/// the ground.
 fn jump_family() -> GeneratorSettings {
     GeneratorSettings {
-        kinds: vec![SceneKind::Ground, SceneKind::Bhop],
+        kinds: vec![SceneKind::Ground, SceneKind::Bhop, SceneKind::Hl2],
         ..GeneratorSettings::ci_sized()
     }
 }
@@ -26,10 +28,10 @@ fn sample() -> Vec<GeneratedScene> {
 }
 
 #[test]
-fn ground_and_bhop_scenes_are_solved_validly_never_slower_than_greedy_nor_before_the_bound() {
+fn ground_bhop_and_hl2_scenes_are_solved_validly_never_slower_than_greedy_nor_before_the_bound() {
     let sample = sample();
-    // Both kinds are in the sample.
-    for kind in [SceneKind::Ground, SceneKind::Bhop] {
+    // Every kind is in the sample.
+    for kind in [SceneKind::Ground, SceneKind::Bhop, SceneKind::Hl2] {
         assert!(
             sample.iter().any(|g| g.drawn.kind == kind),
             "no {kind:?} scene in the sample"
@@ -132,7 +134,7 @@ fn checked(g: &GeneratedScene, o: &Outcome) -> (String, Checked) {
         SceneKind::Ground => assert_eq!(airborne, 0, "{name}: a groundstrafe left the ground"),
         // A bunnyhop plan may groundstrafe all the way (a hairpin in a narrow corridor); whether the
         // plans jump at all is checked over the sample.
-        SceneKind::Bhop => assert_eq!(
+        SceneKind::Bhop | SceneKind::Hl2 => assert_eq!(
             o.controls.iter().any(|c| c.jump),
             airborne > 0,
             "{name}: airborne without a jump, or a jump that never left the ground"

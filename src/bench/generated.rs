@@ -27,7 +27,7 @@ pub struct SceneRecord {
     pub start_speed_ups: u32,
     /// Wall kind.
     pub walls: BoundaryKind,
-    /// Scene kind (airborne, groundstrafing, bunnyhopping).
+    /// Scene kind (airborne, groundstrafing, bunnyhopping, Half-Life 2).
     pub kind: SceneKind,
     /// The plan's crossing frame.
     pub frames: Option<u64>,

@@ -48,6 +48,8 @@ pub enum KindArg {
     Ground,
     /// Bunnyhopping: from the ground with gravity, jumps, the bunnyhop cap and friction.
     Bhop,
+    /// Half-Life 2 (Source) from the ground with gravity, jumps and friction, no jump boost.
+    Hl2,
 }
 
 impl KindArg {
@@ -56,6 +58,7 @@ impl KindArg {
             KindArg::Air => SceneKind::Air,
             KindArg::Ground => SceneKind::Ground,
             KindArg::Bhop => SceneKind::Bhop,
+            KindArg::Hl2 => SceneKind::Hl2,
         }
     }
 }
@@ -93,10 +96,11 @@ pub struct FamilyFlags {
     /// Only this wall kind (default: either).
     #[arg(long, value_enum)]
     pub walls: Option<WallsArg>,
-    /// Scene kinds to choose from, comma-separated (default air): air (airborne at 0-1500 ups), ground
-    /// (groundstrafing from the ground, no gravity), bhop (bunnyhopping: gravity, jumps, the bunnyhop
-    /// cap, friction). Ground and bhop scenes start on the ground at rest or at up to 320 ups along the
-    /// first leg. Scene k keeps its corridor whatever the kinds.
+    /// Scene kinds to choose from, comma-separated (default air): air (GoldSrc, airborne at 0-1500
+    /// ups), ground (GoldSrc groundstrafing, no gravity), bhop (GoldSrc bunnyhopping: gravity, jumps, the
+    /// bunnyhop cap, friction), hl2 (Half-Life 2 with gravity, jumps and friction, no jump boost, the
+    /// frame rate as its tick rate). All but air start on the ground at rest or at up to 320 ups along
+    /// the first leg. Scene k keeps its corridor whatever the kinds.
     #[arg(long, value_enum, value_delimiter = ',')]
     pub kinds: Vec<KindArg>,
 }

@@ -9,9 +9,9 @@
 //! family, [`GeneratorSettings::default`].
 //!
 //! [`GeneratorSettings::kinds`] adds scenes that start on the ground ([`SceneKind`]): groundstrafing
-//! (friction and ground acceleration, no gravity) and bunnyhopping (GoldSrc with gravity, jumps, the
-//! bunnyhop cap and friction). They run through the same corridors; only the engine's effects and the
-//! start differ.
+//! (friction and ground acceleration, no gravity), bunnyhopping (GoldSrc with gravity, jumps, the
+//! bunnyhop cap and friction) and Half-Life 2 jumping (Source, gravity, jumps and friction, no jump
+//! boost). They run through the same corridors; only the engine, its effects and the start differ.
 //!
 //! What is drawn, in this order from the item's stream: the number of turns, the width, the frame rate,
 //! the air acceleration, the start speed and the wall kind; then the corridor, each turn's angle (whole
@@ -83,7 +83,7 @@ pub const FPS_RANGE: std::ops::RangeInclusive<u32> = 10..=10_000;
 pub const AIRACCELERATE_RANGE: std::ops::RangeInclusive<u32> = 1..=1000;
 
 /// What a generated scene's engine and start are; the corridor is drawn the same way for every kind.
-/// Every kind is GoldSrc (`preset = "goldsrc"`) at the drawn frame rate and `sv_airaccelerate`.
+/// Every kind runs at the drawn frame rate (a tick rate for Half-Life 2) and `sv_airaccelerate`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SceneKind {
@@ -96,11 +96,20 @@ pub enum SceneKind {
     /// Bunnyhopping from the ground: effects `air-accel`, `ground-accel`, `friction`, `gravity`, `jump`,
     /// `bhop-cap`, `max-velocity`, `walls` (as `hl-bhop-bend90-100fps`).
     Bhop,
+    /// Half-Life 2 (`preset = "source-hl2"`) jumping from the ground, without the jump boost: effects
+    /// `air-accel`, `ground-accel`, `friction`, `gravity`, `jump`, `max-velocity`, `walls` (as
+    /// `hl2-bend90-66fps`).
+    Hl2,
 }
 
 impl SceneKind {
     /// Every kind, in the order of the command line's help.
-    pub const ALL: [SceneKind; 3] = [SceneKind::Air, SceneKind::Ground, SceneKind::Bhop];
+    pub const ALL: [SceneKind; 4] = [
+        SceneKind::Air,
+        SceneKind::Ground,
+        SceneKind::Bhop,
+        SceneKind::Hl2,
+    ];
 
     /// The name used on the command line, in files and tables.
     pub fn name(self) -> &'static str {
@@ -108,6 +117,23 @@ impl SceneKind {
             SceneKind::Air => "air",
             SceneKind::Ground => "ground",
             SceneKind::Bhop => "bhop",
+            SceneKind::Hl2 => "hl2",
+        }
+    }
+
+    /// The scene file's `preset`.
+    fn preset(self) -> &'static str {
+        match self {
+            SceneKind::Hl2 => "source-hl2",
+            _ => "goldsrc",
+        }
+    }
+
+    /// The engine in words, for the description.
+    fn engine(self) -> &'static str {
+        match self {
+            SceneKind::Hl2 => "Half-Life 2",
+            _ => "GoldSrc",
         }
     }
 
@@ -124,6 +150,9 @@ impl SceneKind {
             SceneKind::Bhop => {
                 r#"["air-accel", "ground-accel", "friction", "gravity", "jump", "bhop-cap", "max-velocity", "walls"]"#
             }
+            SceneKind::Hl2 => {
+                r#"["air-accel", "ground-accel", "friction", "gravity", "jump", "max-velocity", "walls"]"#
+            }
         }
     }
 
@@ -134,6 +163,9 @@ impl SceneKind {
             SceneKind::Ground => "groundstrafing: on the ground with friction, no gravity",
             SceneKind::Bhop => {
                 "bunnyhopping: from the ground with gravity, jumps, the bunnyhop cap and friction"
+            }
+            SceneKind::Hl2 => {
+                "Half-Life 2: from the ground with gravity, jumps and friction, no jump boost"
             }
         }
     }
@@ -309,7 +341,7 @@ impl GeneratorSettings {
             return Err(Error::InvalidValue {
                 name: "kinds".to_string(),
                 value: "an empty list".to_string(),
-                allowed: "one or more of air, ground, bhop".to_string(),
+                allowed: "one or more of air, ground, bhop, hl2".to_string(),
             });
         }
         if !(1..=256).contains(&self.wall_gap_units) {
@@ -618,11 +650,13 @@ fn scene_text(
         SceneKind::Air => "airborne at",
         SceneKind::Ground => "groundstrafing from",
         SceneKind::Bhop => "bunnyhopping from the ground at",
+        SceneKind::Hl2 => "jumping from the ground at",
     };
     let _ = writeln!(
         s,
-        "description = \"Generated (seed {seed}, scene {index}): GoldSrc, {} fps, sv_airaccelerate {}, {start_words} \
+        "description = \"Generated (seed {seed}, scene {index}): {}, {} fps, sv_airaccelerate {}, {start_words} \
          {} ups; {corners} turns ({}), {} units wide, {} walls\"",
+        d.kind.engine(),
         d.fps,
         d.airaccelerate,
         d.start_speed_ups,
@@ -630,7 +664,12 @@ fn scene_text(
         d.width_units,
         d.walls.name()
     );
-    let _ = writeln!(s, "\n[engine]\npreset = \"goldsrc\"\nfps = {}", d.fps);
+    let _ = writeln!(
+        s,
+        "\n[engine]\npreset = \"{}\"\nfps = {}",
+        d.kind.preset(),
+        d.fps
+    );
     let _ = writeln!(s, "airaccelerate = {}", d.airaccelerate);
     let _ = writeln!(s, "effects = {}", d.kind.effects());
     let start = Vec2::new(START_OFFSET_UNITS, 0.0);
