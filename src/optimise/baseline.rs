@@ -7,10 +7,10 @@
 //! the centre line (the guide kept as far off the walls as the corridor allows), every look-ahead, then
 //! the same with speed caps from the radius-speed relation (section 9) on airborne scenes. The fastest
 //! valid run whose engine-exact replay is valid too is the baseline (else the fastest valid run), and
-//! which guide gave it is reported. Groundstrafing (ground movement without jumps) runs capped too, with
-//! caps that are shares of its top speed as well (section 12), but only when no uncapped run is valid in
-//! both arithmetics: maximum acceleration on the ground overshoots a sharp corner of a narrow corridor,
-//! and scraping along a solid wall it parts ways with the game's f32 replay.
+//! which guide gave it is reported. Scenes with ground movement (groundstrafing, jumping) run capped too,
+//! with caps that are shares of the groundstrafing top speed as well (section 12), but only when no
+//! uncapped run is valid in both arithmetics: maximum acceleration overshoots a sharp corner of a narrow
+//! corridor, and scraping along a solid wall it parts ways with the game's f32 replay.
 
 use super::LowerBound;
 use crate::budget::Budget;
@@ -112,8 +112,9 @@ pub(super) fn corner_caps(scene: &Scene) -> Vec<f64> {
 /// hold.
 const GROUND_CAP_SHARES: [f64; 6] = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8];
 
-/// Speed caps of groundstrafing, ups: the air's [`corner_caps`] (the ground turns tighter at a speed, so
-/// they are on the safe side) and shares of the groundstrafing top speed ([`GROUND_CAP_SHARES`]).
+/// Speed caps of scenes with ground movement, ups: the air's [`corner_caps`] (the ground turns tighter at
+/// a speed, so they are on the safe side) and shares of the groundstrafing top speed
+/// ([`GROUND_CAP_SHARES`]).
 fn ground_caps(scene: &Scene) -> Vec<f64> {
     let top = max_groundstrafe_speed(&scene.vars, scene.effects.has(Effect::EdgeFriction));
     let mut caps = corner_caps(scene);
@@ -202,10 +203,10 @@ pub(super) fn baseline(
 ) -> Baseline {
     let guides = guide_paths(scene, bound);
     let fx = scene.effects;
-    // Groundstrafing (ground movement, no jumps) gets the capped runs only when no uncapped run is
-    // valid in both arithmetics: maximum acceleration on the ground overshoots a sharp corner of a
-    // narrow corridor, and along a solid wall it scrapes where the game's f32 replay parts ways.
-    let groundstrafing = !fx.is_air_only() && !fx.has(Effect::Jump);
+    // Ground movement (groundstrafing, jumping) gets the capped runs only when no uncapped run is valid
+    // in both arithmetics: maximum acceleration overshoots a sharp corner of a narrow corridor, and along
+    // a solid wall it scrapes where the game's f32 replay parts ways.
+    let on_ground = !fx.is_air_only();
     let caps = if fx.is_air_only() {
         corner_caps(scene)
     } else {
@@ -214,7 +215,7 @@ pub(super) fn baseline(
     let mut runs = GuideRuns::default();
     sweep_guides(sim, &guides, &caps, true, budget, &mut runs);
     let mut greedy = pick_greedy(sim, &guides, &runs, &[], budget);
-    if groundstrafing && !greedy.engine_valid && !budget.expired() {
+    if on_ground && !greedy.engine_valid && !budget.expired() {
         let checked = runs.valid.clone();
         sweep_guides(sim, &guides, &ground_caps(scene), false, budget, &mut runs);
         greedy = pick_greedy(sim, &guides, &runs, &checked, budget);
