@@ -638,6 +638,38 @@ fn bench_generated_gives_a_record_per_scene_and_the_distributions() {
     assert_eq!(gap["count"], 2);
     assert!(gap["min"].as_f64() <= gap["median"].as_f64());
     assert!(gap["median"].as_f64() <= gap["max"].as_f64());
+    // Each record names its kind; --kinds passes through to the family.
+    assert!(scenes.iter().all(|r| r["kind"] == "air"), "{scenes:?}");
+    let out = run(&[
+        "bench",
+        "--generated",
+        "2",
+        "--seed",
+        "3",
+        "--ci-sized",
+        "--max-corners",
+        "1",
+        "--max-leg",
+        "400",
+        "--fps",
+        "100",
+        "--kinds",
+        "bhop",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(v["family"]["kinds"], serde_json::json!(["bhop"]));
+    for r in v["scenes"].as_array().cloned().unwrap_or_default() {
+        assert_eq!(r["kind"], "bhop", "{r}");
+        assert_eq!(r["valid"], true, "{r}");
+        assert_eq!(r["engine_exact_valid"], true, "{r}");
+    }
     // Family flags belong to --generated.
     let out = run(&["bench", "scenarios/hl-bend90-100fps.toml", "--fps", "100"]);
     assert_eq!(out.status.code(), Some(2));
