@@ -18,8 +18,9 @@
 //! degrees) and side and each leg's length (whole units), drawn again from the same stream until the
 //! corridor does not overlap itself (at most [`GeneratorSettings::max_corridor_draws`] times); then the
 //! scene's kind and, for a kind that starts on the ground, its start speed (which replaces the airborne
-//! one). Drawing the kind last keeps every airborne scene of a seed what it was before kinds existed, and
-//! gives scene `k` the same corridor whatever kinds are asked for.
+//! one). Drawn last, the kind changes nothing drawn before it: scene `k` of a seed has the same corridor,
+//! frame rate, air acceleration and walls whatever kinds are asked for, and an airborne scene is the same
+//! in every family that can draw it (but for the comment line that names the family).
 //!
 //! Choices of shape:
 //! - a leg's length is its straight part: the first from the start wall to the first turn, the last from
@@ -29,8 +30,8 @@
 //!   turn's arcs as polygons, and parts of the corridor that are not neighbours keep their walls at least
 //!   `gap / 2` apart;
 //! - the start is the hull centre [`START_OFFSET_UNITS`] into the first leg on its centre line (as the
-//!   shorthand shapes), airborne or on the ground as the kind says; the start wall closes the corridor behind it; the finish line spans the
-//!   last leg's end, wall to wall;
+//!   shorthand shapes), airborne or on the ground as the kind says; the start wall closes the corridor
+//!   behind it; the finish line spans the last leg's end, wall to wall;
 //! - coordinates are written with three decimals and the scene is the one read back from that text, so
 //!   a file and the [`GeneratedScene::scene`] it came with are the same scene.
 //!
@@ -88,7 +89,7 @@ pub const AIRACCELERATE_RANGE: std::ops::RangeInclusive<u32> = 1..=1000;
 #[serde(rename_all = "kebab-case")]
 pub enum SceneKind {
     /// Airborne at the drawn start speed, air acceleration only: effects `air-accel`, `max-velocity`,
-    /// `walls` (the original family).
+    /// `walls` (the default family).
     Air,
     /// Groundstrafing: on the ground, no gravity, so the whole run is ground frames: effects
     /// `ground-accel`, `friction`, `max-velocity`, `walls` (as `hl-groundstrafe-1000fps`).
@@ -358,8 +359,8 @@ impl GeneratorSettings {
     }
 
     /// The family in one line (`corners 1-6, turns 30-180 deg, ...`), for files and reports. The scene
-    /// kinds and ground start speeds are named only when a kind other than airborne is asked for, so the
-    /// airborne family's line is what it always was.
+    /// kinds and ground start speeds are named only when a kind other than airborne is asked for: the
+    /// airborne family's line does not name them.
     pub fn describe(&self) -> String {
         let join = |v: &[u32]| v.iter().map(u32::to_string).collect::<Vec<_>>().join("/");
         let kinds: Vec<&str> = self.wall_kinds.iter().map(|k| k.name()).collect();
