@@ -1,7 +1,9 @@
 //! The generated family (`scene::generate`, `strafeopt gen`): 500 scenes of the whole family are valid
 //! scenes with a path whose corridor never overlaps itself (checked here from the walls, apart from the
 //! generator's own test), the draws stay in their ranges and cover them, a scene depends only on its seed
-//! and index, and `gen` writes files the scene loader reads.
+//! and index, and `gen` writes files the scene loader reads. The kinds that start on the ground
+//! (groundstrafing, bunnyhopping) are valid scenes with their effects, run through the same corridors
+//! as the airborne scenes of the same index, and cover their start speeds.
 
 mod common;
 
@@ -10,8 +12,9 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use strafeopt::geometry::BoundaryKind;
 use strafeopt::physics::Vec2;
+use strafeopt::physics::{Effect, Preset};
 use strafeopt::scene::generate::{
-    generate, generate_sample, CentrelinePiece, GeneratedScene, GeneratorSettings, Side,
+    generate, generate_sample, CentrelinePiece, GeneratedScene, GeneratorSettings, SceneKind, Side,
 };
 use strafeopt::scene::Scene;
 
@@ -109,7 +112,43 @@ fn assert_matches_drawn(g: &GeneratedScene) {
     let name = &g.name;
     assert_eq!(s.vars.fps, f64::from(d.fps), "{name}");
     assert_eq!(s.vars.airaccelerate, f64::from(d.airaccelerate), "{name}");
-    assert!(!s.start.on_ground, "{name}");
+    assert_eq!(s.start.on_ground, d.kind.on_ground(), "{name}");
+    // Each kind's effects, as the shipped scenes of that kind name them (in frame order).
+    let want: &[Effect] = match d.kind {
+        SceneKind::Air => &[Effect::MaxVelocity, Effect::AirAccel, Effect::Walls],
+        SceneKind::Ground => &[
+            Effect::Friction,
+            Effect::MaxVelocity,
+            Effect::GroundAccel,
+            Effect::Walls,
+        ],
+        SceneKind::Bhop => &[
+            Effect::Gravity,
+            Effect::Jump,
+            Effect::BhopCap,
+            Effect::Friction,
+            Effect::MaxVelocity,
+            Effect::AirAccel,
+            Effect::GroundAccel,
+            Effect::Walls,
+        ],
+        SceneKind::Hl2 => &[
+            Effect::Gravity,
+            Effect::Jump,
+            Effect::Friction,
+            Effect::MaxVelocity,
+            Effect::AirAccel,
+            Effect::GroundAccel,
+            Effect::Walls,
+        ],
+    };
+    assert_eq!(s.effects.list(), want, "{name}");
+    let preset = if d.kind == SceneKind::Hl2 {
+        Preset::SourceHl2
+    } else {
+        Preset::GoldSrc
+    };
+    assert_eq!(s.preset, preset, "{name}");
     assert!(
         (s.start.vel.x - f64::from(d.start_speed_ups)).abs() < 1e-9,
         "{name}"
@@ -146,6 +185,7 @@ fn five_hundred_scenes_of_the_family_are_valid_and_never_overlap_themselves() {
     for g in family_sample() {
         assert_valid(g, f64::from(settings.wall_gap_units));
         assert_matches_drawn(g);
+        assert_eq!(g.drawn.kind, SceneKind::Air, "{}", g.name);
     }
 }
 
@@ -246,6 +286,120 @@ fn the_stream_is_pinned() {
     );
 }
 
+/// The family with every kind.
+fn all_kinds() -> GeneratorSettings {
+    GeneratorSettings {
+        kinds: SceneKind::ALL.to_vec(),
+        ..GeneratorSettings::default()
+    }
+}
+
+#[test]
+fn ground_bhop_and_hl2_scenes_are_valid_and_cover_their_start_speeds() {
+    let settings = all_kinds();
+    let scenes = sample(&settings, 400);
+    for g in &scenes {
+        assert_valid(g, f64::from(settings.wall_gap_units));
+        assert_matches_drawn(g);
+    }
+    let count = |k: SceneKind| scenes.iter().filter(|g| g.drawn.kind == k).count();
+    // Each kind about a quarter of 400 (a binomial's 5 sigma is 43).
+    for k in SceneKind::ALL {
+        assert!((57..=143).contains(&count(k)), "{k:?}: {}", count(k));
+    }
+    let ground: Vec<u32> = scenes
+        .iter()
+        .filter(|g| g.drawn.kind.on_ground())
+        .map(|g| g.drawn.start_speed_ups)
+        .collect();
+    assert!(ground.iter().all(|&v| v <= 320), "{ground:?}");
+    // A quarter at rest (and a few more by the uniform draw), the rest up to 320 ups.
+    let at_rest = ground.iter().filter(|&&v| v == 0).count();
+    assert!(
+        (ground.len() / 8..=ground.len() / 2).contains(&at_rest),
+        "{at_rest} of {} at rest",
+        ground.len()
+    );
+    assert!(ground.iter().any(|&v| v > 0 && v < 30));
+    assert!(ground.iter().any(|&v| v > 300));
+    // The other draws still cover the family: every frame rate and wall kind among the bunnyhops.
+    let bhop_fps: BTreeSet<u32> = scenes
+        .iter()
+        .filter(|g| g.drawn.kind == SceneKind::Bhop)
+        .map(|g| g.drawn.fps)
+        .collect();
+    assert_eq!(bhop_fps, [100, 250, 1000].into());
+    // The text says what the scene is.
+    for g in &scenes {
+        let words = match g.drawn.kind {
+            SceneKind::Air => "airborne at",
+            SceneKind::Ground => "groundstrafing from",
+            SceneKind::Bhop => "bunnyhopping from the ground at",
+            SceneKind::Hl2 => "Half-Life 2, ",
+        };
+        assert!(g.scene.description.contains(words), "{}", g.toml);
+        assert_eq!(
+            g.toml.contains("# Kind: "),
+            g.drawn.kind != SceneKind::Air,
+            "{}",
+            g.toml
+        );
+    }
+}
+
+#[test]
+fn kinds_keep_each_scene_s_corridor_and_the_airborne_scenes() {
+    let air = sample(&GeneratorSettings::default(), 60);
+    let mixed = sample(&all_kinds(), 60);
+    let only_bhop = sample(
+        &GeneratorSettings {
+            kinds: vec![SceneKind::Bhop],
+            ..GeneratorSettings::default()
+        },
+        60,
+    );
+    for ((a, m), b) in air.iter().zip(&mixed).zip(&only_bhop) {
+        // Same corridor, frame rate, air acceleration and walls whatever the kinds.
+        for g in [m, b] {
+            assert_eq!(g.centreline, a.centreline, "{}", g.name);
+            assert_eq!(g.scene.walls, a.scene.walls, "{}", g.name);
+            assert_eq!(g.scene.finish, a.scene.finish, "{}", g.name);
+            let (x, y) = (&g.drawn, &a.drawn);
+            assert_eq!(
+                (
+                    x.width_units,
+                    &x.legs_units,
+                    &x.turns,
+                    x.fps,
+                    x.airaccelerate,
+                    x.walls
+                ),
+                (
+                    y.width_units,
+                    &y.legs_units,
+                    &y.turns,
+                    y.fps,
+                    y.airaccelerate,
+                    y.walls
+                ),
+                "{}",
+                g.name
+            );
+        }
+        assert_eq!(b.drawn.kind, SceneKind::Bhop);
+        // An airborne scene of the mixed family is the airborne family's, but for the family's line.
+        if m.drawn.kind == SceneKind::Air {
+            assert_eq!(m.drawn, a.drawn);
+            assert_eq!(m.scene, a.scene);
+        }
+    }
+    // Scene k is the same drawn alone or in a sample, for every kind.
+    let s = all_kinds();
+    let five = generate_sample(9, 5, &s).unwrap_or_else(|e| panic!("{e}"));
+    let alone = generate(9, 4, &s).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(alone, five[4]);
+}
+
 #[test]
 fn impossible_settings_are_an_error_not_a_hang() {
     // Twelve 180-degree turns with 64-unit legs: only strictly alternating sides (2 draws in 4096) make a
@@ -335,6 +489,45 @@ fn gen_writes_the_files_the_scene_loader_reads() {
         assert_eq!(scene.vars.fps, 1000.0);
         assert!(scene.walls.iter().all(|w| w.kind == BoundaryKind::Solid));
     }
+    // Ground and bunnyhop scenes: the files load, start on the ground, and the line names the kind.
+    let out = run(&[
+        "gen",
+        "--seed",
+        "6",
+        "--count",
+        "6",
+        "-o",
+        &out_dir,
+        "--ci-sized",
+        "--kinds",
+        "ground,bhop",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let settings = GeneratorSettings {
+        kinds: vec![SceneKind::Ground, SceneKind::Bhop],
+        ..GeneratorSettings::ci_sized()
+    };
+    for k in 0..6u64 {
+        let path = dir.join("new").join(format!("gen-6-{k}.toml"));
+        let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let g = generate(6, k, &settings).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(std::fs::read_to_string(&path).unwrap_or_default(), g.toml);
+        assert!(scene.start.on_ground);
+        assert_eq!(
+            scene.effects.has(Effect::Jump),
+            g.drawn.kind == SceneKind::Bhop
+        );
+        let line = stdout.lines().nth(k as usize).unwrap_or("");
+        assert!(
+            line.ends_with(&format!("walls  {}", g.drawn.kind.name())),
+            "{line}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -346,7 +539,7 @@ fn gen_refuses_bad_input_with_exit_2_in_one_line() {
     let _ = std::fs::write(&file, "x");
     let under_file = file.join("sub").display().to_string();
     let ok_dir = dir.join("out").display().to_string();
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 8] = [
         (
             &["gen", "--seed", "1", "--count", "0", "-o", &ok_dir],
             "--count",
@@ -369,6 +562,10 @@ fn gen_refuses_bad_input_with_exit_2_in_one_line() {
             "--fps",
         ),
         (&["gen", "--count", "2", "-o", &ok_dir], "--seed"),
+        (
+            &["gen", "--seed", "1", "-o", &ok_dir, "--kinds", "air,walk"],
+            "--kinds",
+        ),
     ];
     for (args, names) in cases {
         let out = run(args);
@@ -441,6 +638,38 @@ fn bench_generated_gives_a_record_per_scene_and_the_distributions() {
     assert_eq!(gap["count"], 2);
     assert!(gap["min"].as_f64() <= gap["median"].as_f64());
     assert!(gap["median"].as_f64() <= gap["max"].as_f64());
+    // Each record names its kind; --kinds passes through to the family.
+    assert!(scenes.iter().all(|r| r["kind"] == "air"), "{scenes:?}");
+    let out = run(&[
+        "bench",
+        "--generated",
+        "2",
+        "--seed",
+        "3",
+        "--ci-sized",
+        "--max-corners",
+        "1",
+        "--max-leg",
+        "400",
+        "--fps",
+        "100",
+        "--kinds",
+        "bhop",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(v["family"]["kinds"], serde_json::json!(["bhop"]));
+    for r in v["scenes"].as_array().cloned().unwrap_or_default() {
+        assert_eq!(r["kind"], "bhop", "{r}");
+        assert_eq!(r["valid"], true, "{r}");
+        assert_eq!(r["engine_exact_valid"], true, "{r}");
+    }
     // Family flags belong to --generated.
     let out = run(&["bench", "scenarios/hl-bend90-100fps.toml", "--fps", "100"]);
     assert_eq!(out.status.code(), Some(2));

@@ -6,7 +6,7 @@
 
 use crate::geometry::BoundaryKind;
 use crate::optimise::{solve, Quality, SearchSettings};
-use crate::scene::generate::GeneratedScene;
+use crate::scene::generate::{GeneratedScene, SceneKind};
 use serde::Serialize;
 use std::time::{Duration, Instant};
 
@@ -27,6 +27,8 @@ pub struct SceneRecord {
     pub start_speed_ups: u32,
     /// Wall kind.
     pub walls: BoundaryKind,
+    /// Scene kind (airborne, groundstrafing, bunnyhopping, Half-Life 2).
+    pub kind: SceneKind,
     /// The plan's crossing frame.
     pub frames: Option<u64>,
     /// The plan's crossing time, game seconds.
@@ -76,6 +78,7 @@ impl SceneRecord {
             airaccelerate: d.airaccelerate,
             start_speed_ups: d.start_speed_ups,
             walls: d.walls,
+            kind: d.kind,
             frames: None,
             time_s: None,
             valid: false,
@@ -303,6 +306,7 @@ mod tests {
             airaccelerate: 10,
             start_speed_ups: 0,
             walls: BoundaryKind::Rule,
+            kind: SceneKind::Air,
             frames: Some(100),
             time_s: Some(1.0),
             valid: true,

@@ -5,7 +5,7 @@
 use super::write_atomically;
 use crate::error::{Error, Result};
 use crate::geometry::BoundaryKind;
-use crate::scene::generate::{generate_sample, GeneratedScene, GeneratorSettings};
+use crate::scene::generate::{generate_sample, GeneratedScene, GeneratorSettings, SceneKind};
 use clap::{Args, ValueEnum};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -37,6 +37,30 @@ pub enum WallsArg {
     Rule,
     /// Solid walls only.
     Solid,
+}
+
+/// Scene kinds on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum KindArg {
+    /// Airborne, air acceleration only (the default family).
+    Air,
+    /// Groundstrafing: on the ground with friction and ground acceleration, no gravity.
+    Ground,
+    /// Bunnyhopping: from the ground with gravity, jumps, the bunnyhop cap and friction.
+    Bhop,
+    /// Half-Life 2 (Source) from the ground with gravity, jumps and friction, no jump boost.
+    Hl2,
+}
+
+impl KindArg {
+    fn kind(self) -> SceneKind {
+        match self {
+            KindArg::Air => SceneKind::Air,
+            KindArg::Ground => SceneKind::Ground,
+            KindArg::Bhop => SceneKind::Bhop,
+            KindArg::Hl2 => SceneKind::Hl2,
+        }
+    }
 }
 
 /// Flags that narrow the generated family (each replaces one range or list of the settings).
@@ -72,6 +96,13 @@ pub struct FamilyFlags {
     /// Only this wall kind (default: either).
     #[arg(long, value_enum)]
     pub walls: Option<WallsArg>,
+    /// Scene kinds to choose from, comma-separated (default air): air (GoldSrc, airborne at 0-1500
+    /// ups), ground (GoldSrc groundstrafing, no gravity), bhop (GoldSrc bunnyhopping: gravity, jumps, the
+    /// bunnyhop cap, friction), hl2 (Half-Life 2 with gravity, jumps and friction, no jump boost, the
+    /// frame rate as its tick rate). All but air start on the ground at rest or at up to 320 ups along
+    /// the first leg. Scene k keeps its corridor whatever the kinds.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub kinds: Vec<KindArg>,
 }
 
 impl FamilyFlags {
@@ -88,6 +119,7 @@ impl FamilyFlags {
             (self.min_leg.is_some(), "--min-leg"),
             (self.max_leg.is_some(), "--max-leg"),
             (self.walls.is_some(), "--walls"),
+            (!self.kinds.is_empty(), "--kinds"),
         ]
         .into_iter()
         .find_map(|(given, flag)| given.then_some(flag))
@@ -123,6 +155,15 @@ impl FamilyFlags {
                 WallsArg::Solid => BoundaryKind::Solid,
             }];
         }
+        if !self.kinds.is_empty() {
+            let mut kinds: Vec<SceneKind> = Vec::new();
+            for k in self.kinds.iter().map(|k| k.kind()) {
+                if !kinds.contains(&k) {
+                    kinds.push(k);
+                }
+            }
+            s.kinds = kinds;
+        }
         s.validate().map_err(flag_error)?;
         Ok(s)
     }
@@ -130,7 +171,7 @@ impl FamilyFlags {
 
 /// A settings error renamed from the field to the flag that sets it.
 fn flag_error(e: Error) -> Error {
-    const FLAGS: [(&str, &str); 9] = [
+    const FLAGS: [(&str, &str); 10] = [
         ("min_corners", "--min-corners"),
         ("max_corners", "--max-corners"),
         ("min_width_units", "--min-width"),
@@ -140,6 +181,7 @@ fn flag_error(e: Error) -> Error {
         ("fps", "--fps"),
         ("airaccelerate", "--airaccelerate"),
         ("wall_kinds", "--walls"),
+        ("kinds", "--kinds"),
     ];
     match e {
         Error::InvalidValue {
@@ -189,18 +231,19 @@ fn writable_dir(dir: &Path) -> Result<()> {
     std::fs::remove_file(&probe).map_err(refuse)
 }
 
-/// One line about a scene: file, turns, width, fps, air acceleration, start speed, walls.
+/// One line about a scene: file, turns, width, fps, air acceleration, start speed, walls, kind.
 pub fn scene_line(path: &Path, g: &GeneratedScene) -> String {
     let d = &g.drawn;
     format!(
-        "{}  corners {}  width {:>4}  fps {:>4}  aa {:>3}  start {:>4} ups  {} walls\n",
+        "{}  corners {}  width {:>4}  fps {:>4}  aa {:>3}  start {:>4} ups  {} walls  {}\n",
         path.display(),
         d.turns.len(),
         d.width_units,
         d.fps,
         d.airaccelerate,
         d.start_speed_ups,
-        d.walls.name()
+        d.walls.name(),
+        d.kind.name()
     )
 }
 

@@ -5,14 +5,19 @@
 //! acceleration every frame, docs/physics.md section 6, steering only by its side) along each of several
 //! guides: the corridor's shortest path kept 0 to 40 units off the walls and
 //! the centre line (the guide kept as far off the walls as the corridor allows), every look-ahead, then
-//! the same with speed caps from the radius-speed relation (section 9). The fastest valid run is the
-//! baseline, and which guide gave it is reported.
+//! the same with speed caps from the radius-speed relation (section 9) on airborne scenes. The fastest
+//! valid run whose engine-exact replay is valid too is the baseline (else the fastest valid run), and
+//! which guide gave it is reported. Scenes with ground movement (groundstrafing, jumping) run capped too,
+//! with caps that are shares of the groundstrafing top speed as well (section 12), but only when no
+//! uncapped run is valid in both arithmetics: maximum acceleration overshoots a sharp corner of a narrow
+//! corridor, and scraping along a solid wall it parts ways with the game's f32 replay.
 
 use super::LowerBound;
 use crate::budget::Budget;
 use crate::geometry::{Corridor, HULL_HALF_WIDTH_UNITS};
+use crate::physics::closed_form::max_groundstrafe_speed;
 use crate::physics::curvature::{bend_arc_radius, speed_for_radius, turn_arc_radius};
-use crate::physics::Vec2;
+use crate::physics::{Effect, Vec2};
 use crate::scene::Scene;
 use crate::sim::controllers::{Greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{Simulation, Trace};
@@ -136,6 +141,22 @@ fn sharpest_corner_rad(path: &[Vec2]) -> f64 {
     sharpest
 }
 
+/// Shares of the groundstrafing top speed (docs/physics.md section 12) the ground's capped greedy runs
+/// hold.
+const GROUND_CAP_SHARES: [f64; 6] = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8];
+
+/// Speed caps of scenes with ground movement, ups: the air's [`corner_caps`] (the ground turns tighter at
+/// a speed, so they are on the safe side) and shares of the groundstrafing top speed
+/// ([`GROUND_CAP_SHARES`]).
+fn ground_caps(scene: &Scene, path: &[Vec2]) -> Vec<f64> {
+    let top = max_groundstrafe_speed(&scene.vars, scene.effects.has(Effect::EdgeFriction));
+    let mut caps = corner_caps(scene, path);
+    if top.is_finite() {
+        caps.extend(GROUND_CAP_SHARES.iter().map(|f| f * top));
+    }
+    caps
+}
+
 /// A guide path: the shortest path of a body `clearance_units` wider than the hull on either side.
 struct GuidePath {
     clearance_units: f64,
@@ -214,25 +235,85 @@ pub(super) fn baseline(
     budget: &Budget,
 ) -> Baseline {
     let guides = guide_paths(scene, bound);
-    let caps = if scene.effects.is_air_only() {
+    let fx = scene.effects;
+    // Ground movement (groundstrafing, jumping) gets the capped runs only when no uncapped run is valid
+    // in both arithmetics: maximum acceleration overshoots a sharp corner of a narrow corridor, and along
+    // a solid wall it scrapes where the game's f32 replay parts ways.
+    let on_ground = !fx.is_air_only();
+    let caps = if fx.is_air_only() {
         corner_caps(scene, &bound.path)
     } else {
         Vec::new()
     };
-    let strafer = |path: &[Vec2], guide: &GreedyGuide| {
-        let g = Greedy::new(path.to_vec(), guide.lookahead_units);
-        match guide.speed_cap_ups {
-            Some(cap) => g.with_speed_cap(cap),
-            None => g,
-        }
-    };
-    // The fastest valid run, else the best-ranked invalid one, and per guide and cap the fastest clean run.
-    // Per guide and cap, the fastest valid run (the baseline is the fastest of them that is also valid
-    // in the engine-exact mode).
-    let mut valid: Vec<(f64, usize, GreedyGuide)> = Vec::new();
-    let mut fallback: Option<((u8, f64), usize, GreedyGuide)> = None;
-    let mut clean: Vec<(f64, usize, GreedyGuide)> = Vec::new();
-    'sweep: for cap in std::iter::once(None).chain(caps.iter().copied().map(Some)) {
+    let mut runs = GuideRuns::default();
+    sweep_guides(sim, &guides, &caps, true, budget, &mut runs);
+    let mut greedy = pick_greedy(sim, &guides, &runs, &[], budget);
+    if on_ground && !greedy.engine_valid && !budget.expired() {
+        let checked = runs.valid.clone();
+        sweep_guides(
+            sim,
+            &guides,
+            &ground_caps(scene, &bound.path),
+            false,
+            budget,
+            &mut runs,
+        );
+        greedy = pick_greedy(sim, &guides, &runs, &checked, budget);
+    }
+    let clean = runs
+        .clean
+        .into_iter()
+        .take(MAX_STARTS)
+        .map(|(_, i, guide)| replay(sim, &guides, i, guide))
+        .filter(|r| is_clean(&r.trace))
+        .collect();
+    Baseline {
+        greedy: greedy.run,
+        clean,
+    }
+}
+
+/// The verdicts of the greedy runs swept so far, each as its crossing time (or rank), guide index and
+/// guide.
+#[derive(Default)]
+struct GuideRuns {
+    /// Per guide and cap, the fastest valid run, fastest first.
+    valid: Vec<(f64, usize, GreedyGuide)>,
+    /// The best-ranked invalid run while no run is valid: by crossing time, else by how far it got.
+    fallback: Option<((u8, f64), usize, GreedyGuide)>,
+    /// Per guide and cap, the fastest clean run, fastest first.
+    clean: Vec<(f64, usize, GreedyGuide)>,
+}
+
+/// The greedy strafer along guide `path` with `guide`'s look-ahead and cap.
+fn strafer(path: &[Vec2], guide: &GreedyGuide) -> Greedy {
+    let g = Greedy::new(path.to_vec(), guide.lookahead_units);
+    match guide.speed_cap_ups {
+        Some(cap) => g.with_speed_cap(cap),
+        None => g,
+    }
+}
+
+/// Run `i`'s guide played again whole.
+fn replay(sim: &Simulation, guides: &[GuidePath], i: usize, guide: GreedyGuide) -> GuideRun {
+    GuideRun {
+        guide,
+        trace: sim.run(&mut strafer(&guides[i].path, &guide)),
+    }
+}
+
+/// Plays every guide at every look-ahead, with no cap first when `uncapped`, then each of `caps`, for
+/// their verdicts only, into `runs` (kept sorted fastest first).
+fn sweep_guides(
+    sim: &Simulation,
+    guides: &[GuidePath],
+    caps: &[f64],
+    uncapped: bool,
+    budget: &Budget,
+    runs: &mut GuideRuns,
+) {
+    let first = uncapped.then_some(None);
+    'sweep: for cap in first.into_iter().chain(caps.iter().copied().map(Some)) {
         // Capped runs along the shortest path and the widest guide only: the caps are for corners the
         // uncapped strafer overshoots, and every guide in between would multiply the runs.
         let last = guides.len() - 1;
@@ -267,45 +348,64 @@ pub(super) fn baseline(
                     if best_valid.as_ref().is_none_or(|b| t < b.0) {
                         best_valid = Some((t, i, guide));
                     }
-                } else if valid.is_empty() && best_valid.is_none() {
+                } else if runs.valid.is_empty() && best_valid.is_none() {
                     let r = match run.crossing {
                         Some(c) => (1, c.time),
                         None => (2, -along.project(run.end_pos)),
                     };
-                    if fallback.as_ref().is_none_or(|b| r < b.0) {
-                        fallback = Some((r, i, guide));
+                    if runs.fallback.as_ref().is_none_or(|b| r < b.0) {
+                        runs.fallback = Some((r, i, guide));
                     }
                 }
             }
-            clean.extend(best_clean);
-            valid.extend(best_valid);
+            runs.clean.extend(best_clean);
+            runs.valid.extend(best_valid);
         }
     }
-    valid.sort_by(|a, b| a.0.total_cmp(&b.0));
-    clean.sort_by(|a, b| a.0.total_cmp(&b.0));
-    clean.truncate(MAX_STARTS);
-    // The kept runs, played again whole.
-    let replay = |i: usize, guide: GreedyGuide| GuideRun {
-        guide,
-        trace: sim.run(&mut strafer(&guides[i].path, &guide)),
-    };
-    // The fastest valid run whose engine-exact replay is valid too (the f64 run may graze a wall the
-    // game's f32 arithmetic touches), else the fastest valid one. An invalid run kept is replayed within
-    // the budget: it may never end before the frame cap.
-    let engine_valid = valid.iter().find_map(|&(_, i, guide)| {
-        let run = replay(i, guide);
-        sim.run_engine_exact_within(&run.trace.controls, budget)
-            .feasible()
-            .then_some(run)
-    });
-    let greedy = match (engine_valid, valid.first(), fallback) {
-        (Some(run), _, _) => run,
-        (None, Some(&(_, i, guide)), _) => replay(i, guide),
-        (None, None, Some((_, i, guide))) => GuideRun {
+    runs.valid.sort_by(|a, b| a.0.total_cmp(&b.0));
+    runs.clean.sort_by(|a, b| a.0.total_cmp(&b.0));
+}
+
+/// The baseline run picked from `runs`, and whether its engine-exact replay is valid.
+struct Picked {
+    run: GuideRun,
+    engine_valid: bool,
+}
+
+/// The fastest valid run whose engine-exact replay is valid too (the f64 run may graze a wall the game's
+/// f32 arithmetic touches), else the fastest valid one, else the best-ranked invalid one. The valid
+/// runs in `checked` were replayed engine-exact before and failed: they are not replayed again. An
+/// invalid run kept is played within the budget: it may never end before the frame cap.
+fn pick_greedy(
+    sim: &Simulation,
+    guides: &[GuidePath],
+    runs: &GuideRuns,
+    checked: &[(f64, usize, GreedyGuide)],
+    budget: &Budget,
+) -> Picked {
+    let engine_valid =
+        runs.valid
+            .iter()
+            .filter(|v| !checked.contains(v))
+            .find_map(|&(_, i, guide)| {
+                let run = replay(sim, guides, i, guide);
+                sim.run_engine_exact_within(&run.trace.controls, budget)
+                    .feasible()
+                    .then_some(run)
+            });
+    if let Some(run) = engine_valid {
+        return Picked {
+            run,
+            engine_valid: true,
+        };
+    }
+    let run = match (runs.valid.first(), runs.fallback) {
+        (Some(&(_, i, guide)), _) => replay(sim, guides, i, guide),
+        (None, Some((_, i, guide))) => GuideRun {
             guide,
             trace: sim.run_within(&mut strafer(&guides[i].path, &guide), budget),
         },
-        (None, None, None) => {
+        (None, None) => {
             let guide = GreedyGuide {
                 clearance_units: 0.0,
                 centre_line: false,
@@ -318,12 +418,10 @@ pub(super) fn baseline(
             }
         }
     };
-    let clean = clean
-        .into_iter()
-        .map(|(_, i, guide)| replay(i, guide))
-        .filter(|r| is_clean(&r.trace))
-        .collect();
-    Baseline { greedy, clean }
+    Picked {
+        run,
+        engine_valid: false,
+    }
 }
 
 /// A run the planning model can follow: valid, finished, and touching no wall.

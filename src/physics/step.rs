@@ -11,7 +11,7 @@ use super::effects::{Effect, Effects};
 use super::real::Real;
 use super::vars::{
     Game, MovementVars, BHOP_CAP_FACTOR, BHOP_CAP_RESULT_FACTOR, FRICTION_MIN_SPEED_UPS,
-    GROUND_LAYER_UNITS, GROUND_MAX_VZ_UPS, WALK_STOP_SPEED_UPS,
+    GROUND_LAYER_UNITS, WALK_STOP_SPEED_UPS,
 };
 use super::vec2::{Vec2, V2};
 use serde::{Deserialize, Serialize};
@@ -277,6 +277,8 @@ pub struct Stepper<R = f64> {
     tau: R,
     half_gravity_dv: R,
     jump_speed: R,
+    /// [`MovementVars::ground_max_vz_ups`].
+    ground_max_vz: R,
     maxspeed: R,
     accelerate: R,
     airaccelerate: R,
@@ -300,6 +302,7 @@ impl<R: Real> Stepper<R> {
             tau: f(tau),
             half_gravity_dv: f(vars.gravity * tau * 0.5),
             jump_speed: f(vars.jump_speed_ups()),
+            ground_max_vz: f(vars.ground_max_vz_ups()),
             maxspeed: f(vars.maxspeed),
             accelerate: f(vars.accelerate),
             airaccelerate: f(vars.airaccelerate),
@@ -451,8 +454,7 @@ impl<R: Real> Stepper<R> {
                 s.vz = R::ZERO;
             }
         }
-        s.on_ground =
-            s.vz <= R::from_f64(GROUND_MAX_VZ_UPS) && s.z <= R::from_f64(GROUND_LAYER_UNITS);
+        s.on_ground = s.vz <= self.ground_max_vz && s.z <= R::from_f64(GROUND_LAYER_UNITS);
         if s.on_ground {
             s.z = R::ZERO;
             s.vz = R::ZERO;
@@ -740,6 +742,26 @@ mod tests {
             .unwrap_or(0);
         assert_eq!(frames, expected);
         assert_eq!(frames, 665);
+    }
+
+    #[test]
+    fn a_source_jump_leaves_the_ground_at_any_tick_rate() {
+        // Source's standing jump gives v_z = 160 - g tau / 2 (157 ups at 100 ticks/s), which rises only
+        // 1.57 units in the jump frame at 100 ticks/s: inside the 2-unit ground layer. It is off the
+        // ground because v_z is above Source's 140 ups; GoldSrc's 180 would have kept it there.
+        for fps in [66.666_666_666_666_67, 100.0, 250.0, 1000.0] {
+            let vars = MovementVars::source_hl2(fps);
+            let fx = Effects::from_list(&[Effect::Gravity, Effect::Jump]);
+            let st: Stepper<f64> = Stepper::new(&vars, fx);
+            let mut s = PlayerState::on_ground(Vec2::ZERO, Vec2::ZERO);
+            let w = Wish {
+                forward: Vec2::new(1.0, 0.0),
+                jump: true,
+                ..Wish::default()
+            };
+            st.step(&mut s, &w);
+            assert!(!s.on_ground, "{fps} ticks/s: z {} vz {}", s.z, s.vz);
+        }
     }
 
     #[test]

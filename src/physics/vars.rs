@@ -57,8 +57,12 @@ pub const SOURCE_JUMP_SPEED_UPS: f64 = 160.0;
 pub const BHOP_CAP_FACTOR: f64 = 1.7;
 /// Speed after the bunnyhop cap, a multiple of `sv_maxspeed` (`1.7 * 0.65`).
 pub const BHOP_CAP_RESULT_FACTOR: f64 = 1.105;
-/// Above this vertical speed (ups) the player is never on the ground (docs/physics.md section 3, step 6).
+/// Above this vertical speed (ups) a GoldSrc player is never on the ground (docs/physics.md section 3,
+/// step 6: `PM_CatagorizePosition`).
 pub const GROUND_MAX_VZ_UPS: f64 = 180.0;
+/// Above this vertical speed (ups) a Source player is never on the ground (`NON_JUMP_VELOCITY` in
+/// `CGameMovement::CategorizePosition`).
+pub const SOURCE_GROUND_MAX_VZ_UPS: f64 = 140.0;
 /// The ground layer: within this height (units) above a floor the player stands on it.
 pub const GROUND_LAYER_UNITS: f64 = 2.0;
 /// Below this speed (ups) ground friction does nothing (`PM_Friction`: `if (speed < 0.1) return`).
@@ -190,6 +194,15 @@ impl MovementVars {
         match self.game {
             Game::GoldSrc => GOLDSRC_JUMP_SPEED_UPS,
             Game::Source => SOURCE_JUMP_SPEED_UPS,
+        }
+    }
+
+    /// The largest vertical speed at which the player can be on the ground, ups: 180 in GoldSrc, 140 in
+    /// Source (docs/physics.md section 3, step 6).
+    pub fn ground_max_vz_ups(&self) -> f64 {
+        match self.game {
+            Game::GoldSrc => GROUND_MAX_VZ_UPS,
+            Game::Source => SOURCE_GROUND_MAX_VZ_UPS,
         }
     }
 

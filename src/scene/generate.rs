@@ -8,10 +8,19 @@
 //! 0 to 1500 ups along the first leg, between rule or solid walls (docs/physics.md section 10): the default
 //! family, [`GeneratorSettings::default`].
 //!
+//! [`GeneratorSettings::kinds`] adds scenes that start on the ground ([`SceneKind`]): groundstrafing
+//! (friction and ground acceleration, no gravity), bunnyhopping (GoldSrc with gravity, jumps, the
+//! bunnyhop cap and friction) and Half-Life 2 jumping (Source, gravity, jumps and friction, no jump
+//! boost). They run through the same corridors; only the engine, its effects and the start differ.
+//!
 //! What is drawn, in this order from the item's stream: the number of turns, the width, the frame rate,
 //! the air acceleration, the start speed and the wall kind; then the corridor, each turn's angle (whole
 //! degrees) and side and each leg's length (whole units), drawn again from the same stream until the
-//! corridor does not overlap itself (at most [`GeneratorSettings::max_corridor_draws`] times).
+//! corridor does not overlap itself (at most [`GeneratorSettings::max_corridor_draws`] times); then the
+//! scene's kind and, for a kind that starts on the ground, its start speed (which replaces the airborne
+//! one). Drawn last, the kind changes nothing drawn before it: scene `k` of a seed has the same corridor,
+//! frame rate, air acceleration and walls whatever kinds are asked for, and an airborne scene is the same
+//! in every family that can draw it (but for the comment line that names the family).
 //!
 //! Choices of shape:
 //! - a leg's length is its straight part: the first from the start wall to the first turn, the last from
@@ -21,8 +30,8 @@
 //!   turn's arcs as polygons, and parts of the corridor that are not neighbours keep their walls at least
 //!   `gap / 2` apart;
 //! - the start is the hull centre [`START_OFFSET_UNITS`] into the first leg on its centre line (as the
-//!   shorthand shapes), airborne; the start wall closes the corridor behind it; the finish line spans the
-//!   last leg's end, wall to wall;
+//!   shorthand shapes), airborne or on the ground as the kind says; the start wall closes the corridor
+//!   behind it; the finish line spans the last leg's end, wall to wall;
 //! - coordinates are written with three decimals and the scene is the one read back from that text, so
 //!   a file and the [`GeneratedScene::scene`] it came with are the same scene.
 //!
@@ -64,11 +73,104 @@ pub const MAX_LEG_UNITS: u32 = 20_000;
 /// Largest start speed, ups: GoldSrc's `sv_maxvelocity`, which clamps each velocity component.
 pub const MAX_START_SPEED_UPS: u32 = 2000;
 
+/// Default of [`GeneratorSettings::max_ground_start_speed_ups`], ups: GoldSrc's `sv_maxspeed`, running
+/// speed.
+pub const MAX_GROUND_START_SPEED_UPS: u32 = 320;
+
 /// Frame rates accepted, fps.
 pub const FPS_RANGE: std::ops::RangeInclusive<u32> = 10..=10_000;
 
 /// `sv_airaccelerate` values accepted.
 pub const AIRACCELERATE_RANGE: std::ops::RangeInclusive<u32> = 1..=1000;
+
+/// What a generated scene's engine and start are; the corridor is drawn the same way for every kind.
+/// Every kind runs at the drawn frame rate (a tick rate for Half-Life 2) and `sv_airaccelerate`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SceneKind {
+    /// Airborne at the drawn start speed, air acceleration only: effects `air-accel`, `max-velocity`,
+    /// `walls` (the default family).
+    Air,
+    /// Groundstrafing: on the ground, no gravity, so the whole run is ground frames: effects
+    /// `ground-accel`, `friction`, `max-velocity`, `walls` (as `hl-groundstrafe-1000fps`).
+    Ground,
+    /// Bunnyhopping from the ground: effects `air-accel`, `ground-accel`, `friction`, `gravity`, `jump`,
+    /// `bhop-cap`, `max-velocity`, `walls` (as `hl-bhop-bend90-100fps`).
+    Bhop,
+    /// Half-Life 2 (`preset = "source-hl2"`) jumping from the ground, without the jump boost: effects
+    /// `air-accel`, `ground-accel`, `friction`, `gravity`, `jump`, `max-velocity`, `walls` (as
+    /// `hl2-bend90-66fps`).
+    Hl2,
+}
+
+impl SceneKind {
+    /// Every kind, in the order of the command line's help.
+    pub const ALL: [SceneKind; 4] = [
+        SceneKind::Air,
+        SceneKind::Ground,
+        SceneKind::Bhop,
+        SceneKind::Hl2,
+    ];
+
+    /// The name used on the command line, in files and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            SceneKind::Air => "air",
+            SceneKind::Ground => "ground",
+            SceneKind::Bhop => "bhop",
+            SceneKind::Hl2 => "hl2",
+        }
+    }
+
+    /// The scene file's `preset`.
+    fn preset(self) -> &'static str {
+        match self {
+            SceneKind::Hl2 => "source-hl2",
+            _ => "goldsrc",
+        }
+    }
+
+    /// The engine in words, for the description.
+    fn engine(self) -> &'static str {
+        match self {
+            SceneKind::Hl2 => "Half-Life 2",
+            _ => "GoldSrc",
+        }
+    }
+
+    /// True for the kinds that start on the ground.
+    pub fn on_ground(self) -> bool {
+        !matches!(self, SceneKind::Air)
+    }
+
+    /// The scene file's `effects` list.
+    fn effects(self) -> &'static str {
+        match self {
+            SceneKind::Air => r#"["air-accel", "max-velocity", "walls"]"#,
+            SceneKind::Ground => r#"["ground-accel", "friction", "max-velocity", "walls"]"#,
+            SceneKind::Bhop => {
+                r#"["air-accel", "ground-accel", "friction", "gravity", "jump", "bhop-cap", "max-velocity", "walls"]"#
+            }
+            SceneKind::Hl2 => {
+                r#"["air-accel", "ground-accel", "friction", "gravity", "jump", "max-velocity", "walls"]"#
+            }
+        }
+    }
+
+    /// The kind in words, for the file's comment and description.
+    fn describe(self) -> &'static str {
+        match self {
+            SceneKind::Air => "airborne, air acceleration only",
+            SceneKind::Ground => "groundstrafing: on the ground with friction, no gravity",
+            SceneKind::Bhop => {
+                "bunnyhopping: from the ground with gravity, jumps, the bunnyhop cap and friction"
+            }
+            SceneKind::Hl2 => {
+                "Half-Life 2: from the ground with gravity, jumps and friction, no jump boost"
+            }
+        }
+    }
+}
 
 /// The family to draw from: every range inclusive, in whole units, degrees, fps and ups. `Default` is the
 /// full family; [`GeneratorSettings::ci_sized`] a smaller one whose solves take seconds.
@@ -100,6 +202,13 @@ pub struct GeneratorSettings {
     pub max_start_speed_ups: u32,
     /// Wall kinds to choose from.
     pub wall_kinds: Vec<BoundaryKind>,
+    /// Scene kinds to choose from (default: airborne only).
+    pub kinds: Vec<SceneKind>,
+    /// Smallest start speed of a kind that starts on the ground, ups; a quarter of those scenes start at
+    /// exactly this speed (at rest by default), the rest uniformly up to the largest.
+    pub min_ground_start_speed_ups: u32,
+    /// Largest start speed of a kind that starts on the ground, ups (at most [`MAX_START_SPEED_UPS`]).
+    pub max_ground_start_speed_ups: u32,
     /// Margin between two parts of the corridor that are not neighbours: their centre lines stay
     /// `width + gap` apart and their walls at least `gap / 2`; also the divider's thickness at a
     /// 180-degree turn, units (1 to 256).
@@ -125,6 +234,9 @@ impl Default for GeneratorSettings {
             min_start_speed_ups: 0,
             max_start_speed_ups: 1500,
             wall_kinds: vec![BoundaryKind::Rule, BoundaryKind::Solid],
+            kinds: vec![SceneKind::Air],
+            min_ground_start_speed_ups: 0,
+            max_ground_start_speed_ups: MAX_GROUND_START_SPEED_UPS,
             wall_gap_units: 16,
             max_corridor_draws: MAX_CORRIDOR_DRAWS,
         }
@@ -193,6 +305,13 @@ impl GeneratorSettings {
             0,
             MAX_START_SPEED_UPS,
         )?;
+        range(
+            "ground_start_speed_ups",
+            self.min_ground_start_speed_ups,
+            self.max_ground_start_speed_ups,
+            0,
+            MAX_START_SPEED_UPS,
+        )?;
         let list = |name: &str, values: &[u32], allowed: &std::ops::RangeInclusive<u32>| {
             if values.is_empty() {
                 return Err(Error::InvalidValue {
@@ -219,6 +338,13 @@ impl GeneratorSettings {
                 allowed: "rule, solid or both".to_string(),
             });
         }
+        if self.kinds.is_empty() {
+            return Err(Error::InvalidValue {
+                name: "kinds".to_string(),
+                value: "an empty list".to_string(),
+                allowed: "one or more of air, ground, bhop, hl2".to_string(),
+            });
+        }
         if !(1..=256).contains(&self.wall_gap_units) {
             return Err(Error::invalid(
                 "wall_gap_units",
@@ -232,11 +358,13 @@ impl GeneratorSettings {
         Ok(())
     }
 
-    /// The family in one line (`corners 1-6, turns 30-180 deg, ...`), for files and reports.
+    /// The family in one line (`corners 1-6, turns 30-180 deg, ...`), for files and reports. The scene
+    /// kinds and ground start speeds are named only when a kind other than airborne is asked for: the
+    /// airborne family's line does not name them.
     pub fn describe(&self) -> String {
         let join = |v: &[u32]| v.iter().map(u32::to_string).collect::<Vec<_>>().join("/");
         let kinds: Vec<&str> = self.wall_kinds.iter().map(|k| k.name()).collect();
-        format!(
+        let mut line = format!(
             "corners {}-{}, turns {}-{} deg, widths {}-{} units, legs {}-{} units, fps {}, \
              airaccelerate {}, start speeds {}-{} ups, {} walls, wall gap {} units",
             self.min_corners,
@@ -253,7 +381,19 @@ impl GeneratorSettings {
             self.max_start_speed_ups,
             kinds.join("/"),
             self.wall_gap_units,
-        )
+        );
+        if self.kinds != [SceneKind::Air] {
+            let names: Vec<&str> = self.kinds.iter().map(|k| k.name()).collect();
+            let _ = write!(line, ", kinds {}", names.join("/"));
+            if self.kinds.iter().any(|k| k.on_ground()) {
+                let _ = write!(
+                    line,
+                    ", ground start speeds {}-{} ups",
+                    self.min_ground_start_speed_ups, self.max_ground_start_speed_ups
+                );
+            }
+        }
+        line
     }
 }
 
@@ -279,10 +419,13 @@ pub struct Drawn {
     pub fps: u32,
     /// `sv_airaccelerate`.
     pub airaccelerate: u32,
-    /// Start speed along the first leg, ups.
+    /// Start speed along the first leg, ups: the airborne draw, or the ground draw for a kind that starts
+    /// on the ground.
     pub start_speed_ups: u32,
     /// Kind of every wall.
     pub walls: BoundaryKind,
+    /// The scene's kind: its effects and whether it starts on the ground.
+    pub kind: SceneKind,
     /// Corridors drawn until one did not overlap itself (1 when the first did).
     pub corridor_draws: u32,
 }
@@ -339,6 +482,12 @@ pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<G
         if overlaps_itself(&layout.pieces, width, gap) {
             continue;
         }
+        let kind = pick(&mut rng, &settings.kinds)?;
+        let start_speed_ups = if kind.on_ground() {
+            ground_start_speed(&mut rng, settings)
+        } else {
+            start_speed_ups
+        };
         let drawn = Drawn {
             width_units,
             legs_units,
@@ -350,6 +499,7 @@ pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<G
             airaccelerate,
             start_speed_ups,
             walls,
+            kind,
             corridor_draws: draw,
         };
         let name = format!("gen-{seed}-{index}");
@@ -391,6 +541,17 @@ fn draw_corridor(
         .map(|_| rng.in_range(settings.min_leg_units, settings.max_leg_units))
         .collect();
     (turns, legs)
+}
+
+/// A ground start's speed: a quarter of the time the range's lowest (at rest by default), else uniform
+/// over the range, ups.
+fn ground_start_speed(rng: &mut SplitMix64, settings: &GeneratorSettings) -> u32 {
+    let lo = settings.min_ground_start_speed_ups;
+    if rng.below(4) == 0 {
+        lo
+    } else {
+        rng.in_range(lo, settings.max_ground_start_speed_ups)
+    }
 }
 
 /// Scenes `0..count` of the family `seed`: the fixed sample tests and benches use.
@@ -468,6 +629,9 @@ fn header_comment(seed: u64, index: u64, settings: &GeneratorSettings, d: &Drawn
         d.walls.name(),
         d.corridor_draws
     );
+    if d.kind != SceneKind::Air {
+        let _ = writeln!(s, "# Kind: {} ({}).", d.kind.name(), d.kind.describe());
+    }
     s
 }
 
@@ -483,10 +647,17 @@ fn scene_text(
     let corners = d.turns.len();
     let mut s = header_comment(seed, index, settings, d);
     let _ = writeln!(s, "name = \"{name}\"");
+    let start_words = match d.kind {
+        SceneKind::Air => "airborne at",
+        SceneKind::Ground => "groundstrafing from",
+        SceneKind::Bhop => "bunnyhopping from the ground at",
+        SceneKind::Hl2 => "jumping from the ground at",
+    };
     let _ = writeln!(
         s,
-        "description = \"Generated (seed {seed}, scene {index}): GoldSrc, {} fps, sv_airaccelerate {}, airborne at \
+        "description = \"Generated (seed {seed}, scene {index}): {}, {} fps, sv_airaccelerate {}, {start_words} \
          {} ups; {corners} turns ({}), {} units wide, {} walls\"",
+        d.kind.engine(),
         d.fps,
         d.airaccelerate,
         d.start_speed_ups,
@@ -494,16 +665,22 @@ fn scene_text(
         d.width_units,
         d.walls.name()
     );
-    let _ = writeln!(s, "\n[engine]\npreset = \"goldsrc\"\nfps = {}", d.fps);
+    let _ = writeln!(
+        s,
+        "\n[engine]\npreset = \"{}\"\nfps = {}",
+        d.kind.preset(),
+        d.fps
+    );
     let _ = writeln!(s, "airaccelerate = {}", d.airaccelerate);
-    let _ = writeln!(s, "effects = [\"air-accel\", \"max-velocity\", \"walls\"]");
+    let _ = writeln!(s, "effects = {}", d.kind.effects());
     let start = Vec2::new(START_OFFSET_UNITS, 0.0);
     let velocity = Vec2::new(f64::from(d.start_speed_ups), 0.0);
     let _ = writeln!(
         s,
-        "\n[start]\nposition = {}\nvelocity = {}\non-ground = false",
+        "\n[start]\nposition = {}\nvelocity = {}\non-ground = {}",
         point(start),
-        point(velocity)
+        point(velocity),
+        d.kind.on_ground()
     );
     let (finish_a, finish_b) = match (layout.left.last(), layout.right.last()) {
         (Some(&a), Some(&b)) => (a, b),
@@ -548,6 +725,7 @@ mod tests {
         assert_eq!(s.fps, [100, 250, 1000]);
         assert_eq!(s.airaccelerate, [10, 100]);
         assert_eq!((s.min_start_speed_ups, s.max_start_speed_ups), (0, 1500));
+        assert_eq!(s.kinds, [SceneKind::Air]);
         assert!(GeneratorSettings::ci_sized().validate().is_ok());
     }
 
@@ -570,6 +748,15 @@ mod tests {
         assert_eq!(bad(|s| s.max_start_speed_ups = 2001), "max_start_speed_ups");
         assert_eq!(bad(|s| s.wall_kinds.clear()), "wall_kinds");
         assert_eq!(bad(|s| s.wall_gap_units = 0), "wall_gap_units");
+        assert_eq!(bad(|s| s.kinds.clear()), "kinds");
+        assert_eq!(
+            bad(|s| s.max_ground_start_speed_ups = 2001),
+            "max_ground_start_speed_ups"
+        );
+        assert_eq!(
+            bad(|s| s.min_ground_start_speed_ups = 400),
+            "min_ground_start_speed_ups"
+        );
     }
 
     #[test]
