@@ -34,6 +34,10 @@ const CENTRE_LINE_MAX_UNITS: f64 = 1024.0;
 /// Corridor widths, units, whose bend arcs give the greedy strafer's speed caps (see [`corner_caps`]).
 const CAP_WIDTHS_UNITS: [f64; 5] = [16.0, 32.0, 64.0, 128.0, 256.0];
 
+/// An invalid greedy run still short of the line after this many times the lower bound's frames is
+/// given up (ranked by how far it got).
+const BROKEN_RUN_BOUND_FACTOR: u64 = 2;
+
 /// The distinct clean runs kept as starts of the relaxed problem, at most.
 pub(super) const MAX_STARTS: usize = 4;
 
@@ -246,7 +250,17 @@ pub(super) fn baseline(
         Vec::new()
     };
     let mut runs = GuideRuns::default();
-    sweep_guides(sim, &guides, &caps, true, budget, &mut runs);
+    // An invalid run is ranked by when it crosses; one still going at this frame is given up.
+    let broken_frame_limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames.max(1);
+    sweep_guides(
+        sim,
+        &guides,
+        &caps,
+        true,
+        broken_frame_limit,
+        budget,
+        &mut runs,
+    );
     let mut greedy = pick_greedy(sim, &guides, &runs, &[], budget);
     if on_ground && !greedy.engine_valid && !budget.expired() {
         let checked = runs.valid.clone();
@@ -255,6 +269,7 @@ pub(super) fn baseline(
             &guides,
             &ground_caps(scene, &bound.path),
             false,
+            broken_frame_limit,
             budget,
             &mut runs,
         );
@@ -309,6 +324,7 @@ fn sweep_guides(
     guides: &[GuidePath],
     caps: &[f64],
     uncapped: bool,
+    broken_frame_limit: u64,
     budget: &Budget,
     runs: &mut GuideRuns,
 ) {
@@ -335,8 +351,11 @@ fn sweep_guides(
                     lookahead_units: la,
                     speed_cap_ups: cap,
                 };
-                // An invalid run counts only by how far it got: it is not played past its first broken rule.
-                let run = sim.run_summary_until_broken(&mut strafer(&g.path, &guide), budget);
+                let run = sim.run_summary_broken_until(
+                    &mut strafer(&g.path, &guide),
+                    budget,
+                    broken_frame_limit,
+                );
                 let t = match (run.feasible(), run.crossing) {
                     (true, Some(c)) => c.time,
                     _ => f64::INFINITY,

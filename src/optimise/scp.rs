@@ -188,8 +188,6 @@ pub struct ScpSolver<'c> {
     stats: SearchStats,
     /// Dynamics duals of the last solved sub-problem, per frame: the curvature weights.
     duals: Option<Vec<[f64; 4]>>,
-    /// The share of the convexified curvature the model carries, in `(0, 1]` (see [`CURVATURE_MIN_SHARE`]).
-    curvature_share: f64,
     /// The cost after each iteration so far.
     costs: Vec<f64>,
     /// The stage's iteration cap (the stall test weighs the iterations left).
@@ -208,7 +206,6 @@ impl<'c> ScpSolver<'c> {
             converged: false,
             stats: SearchStats::default(),
             duals: None,
-            curvature_share: 1.0,
             costs: Vec::new(),
             max_iters: u64::MAX,
         }
@@ -226,13 +223,6 @@ const MERIT_MARGIN_SHARE: f64 = 0.5;
 
 /// Iterations over which the pace of a stage short of the line is measured.
 const STALL_WINDOW: usize = 10;
-
-/// Above this ratio of actual to predicted gain the model's curvature share is halved.
-const CURVATURE_SHRINK_RATIO: f64 = 1.5;
-/// Below this ratio it is doubled again (up to the whole curvature).
-const CURVATURE_GROW_RATIO: f64 = 0.75;
-/// The least share of the curvature the model keeps.
-const CURVATURE_MIN_SHARE: f64 = 1e-3;
 
 /// Least share of the predicted gain a step must deliver to be accepted.
 const ACCEPT_RATIO: f64 = 0.1;
@@ -268,7 +258,6 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let controls = unpack(&param);
         let (trust, sigma_trust, c_trust) = (self.trust, self.sigma_trust, self.c_trust_ups);
         let upper_at_kink = state.get_iter() % 2 == 0;
-        let share = self.curvature_share;
         let duals = self.duals.take();
         let seconds_left = self
             .budget
@@ -295,10 +284,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
                     }
                 })
                 .collect();
-            let mut lin = pr.linearise(&lin_controls, duals.as_deref());
-            for v in lin.curvature.iter_mut().flatten().flatten().flatten() {
-                *v *= share;
-            }
+            let lin = pr.linearise(&lin_controls, duals.as_deref());
             let mut sigma_range = Vec::with_capacity(controls.len());
             let mut c_range = Vec::with_capacity(controls.len());
             let mut speed = pr.start.speed;
@@ -366,15 +352,6 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let new_cost = problem.cost(&candidate).unwrap_or(f64::INFINITY);
         let actual = cost - new_cost;
         let ratio = actual / step.predicted;
-        // The model's curvature is each frame's block with its negative part cut off, so it is more
-        // curved than the Lagrangian wherever neighbouring blocks' curvatures cancel: the step falls short
-        // and the merit gains about twice the prediction, iteration after iteration. Scaling the
-        // curvature to what the re-simulation confirms lengthens those steps.
-        if ratio > CURVATURE_SHRINK_RATIO {
-            self.curvature_share = (self.curvature_share * 0.5).max(CURVATURE_MIN_SHARE);
-        } else if ratio < CURVATURE_GROW_RATIO {
-            self.curvature_share = (self.curvature_share * 2.0).min(1.0);
-        }
         if actual > 0.0 && ratio >= ACCEPT_RATIO {
             if ratio > 0.75 {
                 self.trust = (self.trust * 2.0).min(4.0);

@@ -220,25 +220,26 @@ impl<'s> Simulation<'s> {
     /// memory that does not grow with the run's length, for sweeps that keep only their best run (and
     /// replay it with [`Self::run`]).
     pub fn run_summary(&self, controller: &mut dyn Controller, budget: &Budget) -> RunSummary {
-        self.summarise(controller, budget, false)
+        self.summarise(controller, budget, None)
     }
 
-    /// [`Self::run_summary`] that stops at the first frame breaking a rule: the run is invalid from there
-    /// on, and a sweep that ranks invalid runs only by how far they got need not play the rest (an invalid
-    /// run may wander until the frame cap).
-    pub fn run_summary_until_broken(
+    /// [`Self::run_summary`] that gives a run up once it has broken a rule and run `broken_frame_limit`
+    /// frames: an invalid run is then only ranked by when it crosses, and one that has not crossed by then
+    /// need not be played on (an invalid run may wander until the frame cap).
+    pub fn run_summary_broken_until(
         &self,
         controller: &mut dyn Controller,
         budget: &Budget,
+        broken_frame_limit: u64,
     ) -> RunSummary {
-        self.summarise(controller, budget, true)
+        self.summarise(controller, budget, Some(broken_frame_limit))
     }
 
     fn summarise(
         &self,
         controller: &mut dyn Controller,
         budget: &Budget,
-        stop_on_broken_rule: bool,
+        broken_frame_limit: Option<u64>,
     ) -> RunSummary {
         let tau = self.stepper.frame_time_s();
         let mut s = self.scene.start;
@@ -266,7 +267,7 @@ impl<'s> Simulation<'s> {
             summary.end_pos = s.pos;
             summary.collisions += out.contacts;
             summary.broke_rule |= out.broke_rule;
-            if stop_on_broken_rule && summary.broke_rule {
+            if summary.broke_rule && broken_frame_limit.is_some_and(|limit| frame >= limit) {
                 break;
             }
             if let Some(f) = self.scene.finish.crossing_fraction(out.from, s.pos) {
