@@ -256,6 +256,43 @@ fn text_output_has_fixed_decimals_in_one_column_and_no_progress_off_a_terminal()
 }
 
 #[test]
+fn a_broken_run_is_given_up_at_its_frame_limit_and_a_valid_one_is_not() {
+    use strafeopt::budget::Budget;
+    use strafeopt::sim::{Greedy, Simulation};
+    // On the narrow bend every look-ahead breaks a rule (at frame 289 for the look-ahead of 100): played
+    // with a limit of 300 frames it stops there, uncrossed; the wide bend's valid run crosses past the
+    // limit all the same.
+    for (name, broken) in [
+        ("hl-bend90-narrow-100fps", true),
+        ("hl-bend90-100fps", false),
+    ] {
+        let scene = Scene::from_toml_str(&shipped(name), name).unwrap_or_else(|e| panic!("{e}"));
+        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+        let bound = strafeopt::optimise::lower_bound(&scene, sim.corridor())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let full = sim.run(&mut Greedy::new(bound.path.clone(), 100.0));
+        let limited = sim.run_summary_broken_until(
+            &mut Greedy::new(bound.path.clone(), 100.0),
+            &Budget::unlimited(),
+            300,
+        );
+        assert_eq!(limited.broke_rule, broken, "{name}");
+        if broken {
+            let first = full.first_rule_violation();
+            assert!(first.is_some_and(|f| f <= 300), "{name}: {first:?}");
+            assert_eq!(limited.frames_run, 300, "{name}");
+            assert!(
+                limited.crossing.is_none() && full.crossing.is_some(),
+                "{name}"
+            );
+        } else {
+            assert_eq!(limited.crossing, full.crossing, "{name}");
+            assert!(limited.feasible(), "{name}");
+        }
+    }
+}
+
+#[test]
 fn a_run_summary_gives_the_verdicts_of_the_full_run() {
     use strafeopt::budget::Budget;
     use strafeopt::sim::{Greedy, Simulation};

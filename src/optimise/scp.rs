@@ -482,3 +482,28 @@ pub(super) fn model_crossing(
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn solver_with(costs: &[f64], max_iters: u64) -> ScpSolver<'static> {
+        let mut s = ScpSolver::new(1e-6, Budget::unlimited());
+        s.costs = costs.to_vec();
+        s.max_iters = max_iters;
+        s
+    }
+
+    #[test]
+    fn a_stage_short_of_the_line_stops_only_when_its_pace_cannot_reach_it() {
+        // 2 units short, gaining 0.01 a step: 100 iterations left would close only 1 unit.
+        let creeping: Vec<f64> = (0..=10).map(|k| 2.1 - 0.01 * f64::from(k)).collect();
+        assert!(solver_with(&creeping, 110).stalled_short_of_the_line(2.0, 10));
+        // The same pace with 300 iterations left could close 3 units: go on.
+        assert!(!solver_with(&creeping, 310).stalled_short_of_the_line(2.0, 10));
+        // Past the line (cost <= 0) never stalls, nor does a stage without a window of history.
+        let past: Vec<f64> = (0..=10).map(|k| -0.1 - 1e-6 * f64::from(k)).collect();
+        assert!(!solver_with(&past, 110).stalled_short_of_the_line(-0.10001, 10));
+        assert!(!solver_with(&creeping[..5], 110).stalled_short_of_the_line(2.06, 4));
+    }
+}
