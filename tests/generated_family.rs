@@ -5,6 +5,8 @@
 //! same frame, never slower than the strongest greedy run, never below the lower bound, and the relaxed
 //! certificate lies between the bound and the plan.
 
+mod common;
+
 use strafeopt::optimise::{solve, Quality, SearchSettings};
 use strafeopt::scene::generate::{generate_sample, GeneratedScene, GeneratorSettings};
 
@@ -19,35 +21,9 @@ fn the_generated_family_is_solved_validly_never_slower_than_greedy_nor_below_the
         .unwrap_or_else(|e| panic!("{e}"));
     let settings = SearchSettings::for_quality(Quality::Fast);
     // Solved on as many threads as the machine has cores; each scene's checks are its own.
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let results: Vec<(usize, String, Option<f64>)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut done = Vec::new();
-                    loop {
-                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(g) = sample.get(k) else { break };
-                        let (line, loss) = checked(g, &settings);
-                        done.push((k, line, loss));
-                    }
-                    done
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| {
-                h.join()
-                    .unwrap_or_else(|_| panic!("a scene's checks failed"))
-            })
-            .collect()
-    });
-    let mut results = results;
-    results.sort_by_key(|r| r.0);
-    let report: Vec<String> = results.iter().map(|r| r.1.clone()).collect();
-    let losses: Vec<f64> = results.iter().filter_map(|r| r.2).collect();
+    let results = common::on_every_core(&sample, |g| checked(g, &settings));
+    let report: Vec<String> = results.iter().map(|r| r.0.clone()).collect();
+    let losses: Vec<f64> = results.iter().filter_map(|r| r.1).collect();
     eprintln!("{}", report.join("\n"));
     // Most scenes are planned: the certificate exists wherever the optimiser's plan won.
     assert!(

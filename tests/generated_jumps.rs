@@ -5,6 +5,8 @@
 //! groundstrafing plan never leaves the ground and a jumping plan is airborne exactly when it jumps. Most
 //! bunnyhop plans jump and beat greedy. One scene is solved twice to the same controls.
 
+mod common;
+
 use strafeopt::optimise::{solve, Outcome, Quality, SearchSettings};
 use strafeopt::scene::generate::{generate_sample, GeneratedScene, GeneratorSettings, SceneKind};
 
@@ -38,39 +40,15 @@ fn ground_bhop_and_hl2_scenes_are_solved_validly_never_slower_than_greedy_nor_be
         );
     }
     let settings = SearchSettings::for_quality(Quality::Fast);
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut results: Vec<(usize, String, Checked)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut done = Vec::new();
-                    loop {
-                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(g) = sample.get(k) else { break };
-                        let o = solve(&g.scene, &settings)
-                            .unwrap_or_else(|e| panic!("{}: {e}", g.name));
-                        let (line, c) = checked(g, &o);
-                        done.push((k, line, c));
-                    }
-                    done
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| {
-                h.join()
-                    .unwrap_or_else(|_| panic!("a scene's checks failed"))
-            })
-            .collect()
+    let results = common::on_every_core(&sample, |g| {
+        let o = solve(&g.scene, &settings).unwrap_or_else(|e| panic!("{}: {e}", g.name));
+        checked(g, &o)
     });
-    results.sort_by_key(|r| r.0);
     eprintln!(
         "{}",
         results
             .iter()
-            .map(|r| r.1.as_str())
+            .map(|r| r.0.as_str())
             .collect::<Vec<_>>()
             .join("\n")
     );
@@ -78,8 +56,9 @@ fn ground_bhop_and_hl2_scenes_are_solved_validly_never_slower_than_greedy_nor_be
     // and most of its plans jump (one that never jumped would be groundstrafing only).
     let bhops: Vec<Checked> = results
         .iter()
-        .filter(|r| sample[r.0].drawn.kind == SceneKind::Bhop)
-        .map(|r| r.2)
+        .zip(&sample)
+        .filter(|(_, g)| g.drawn.kind == SceneKind::Bhop)
+        .map(|(r, _)| r.1)
         .collect();
     let won = bhops.iter().filter(|c| c.faster_than_greedy).count();
     let jumped = bhops.iter().filter(|c| c.jumps).count();
