@@ -31,6 +31,7 @@
 //! replayed engine-exact before it is kept.
 
 use super::bound::{bhop_cap_horizontal_speed, LowerBound};
+use super::policy_run::{keep_if_better, PolicyRun};
 use super::search::{Quality, SearchSettings, SearchStatus};
 use crate::budget::Budget;
 use crate::physics::closed_form::max_groundstrafe_speed;
@@ -40,7 +41,7 @@ use crate::physics::strafe::{
 };
 use crate::physics::{friction, AccelLaw, Control, Effect, PlayerState, Side, Vec2, Wish};
 use crate::sim::controllers::GREEDY_LOOKAHEADS_UNITS;
-use crate::sim::{Controller, EngineRun, Greedy, Simulation, Trace};
+use crate::sim::{Controller, Greedy, Simulation, Trace};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -226,34 +227,8 @@ impl Controller for HopRunner {
     }
 }
 
-/// One evaluated candidate.
-#[derive(Clone, Debug)]
-pub struct HopCandidate {
-    /// The policy played.
-    pub policy: HopPolicy,
-    /// Its run in `f64`.
-    pub trace: Trace,
-    /// Its controls replayed engine-exact.
-    pub engine_exact: EngineRun,
-}
-
-impl HopCandidate {
-    /// Valid in `f64` and in the engine-exact replay, crossing in both.
-    pub fn valid(&self) -> bool {
-        self.trace.feasible()
-            && self.trace.crossing.is_some()
-            && self.engine_exact.feasible()
-            && self.engine_exact.crossing.is_some()
-    }
-
-    /// The `f64` crossing time, seconds; infinite when not valid.
-    pub fn time(&self) -> f64 {
-        match self.trace.crossing {
-            Some(c) if self.valid() => c.time,
-            _ => f64::INFINITY,
-        }
-    }
-}
+/// One evaluated hop policy.
+pub type HopCandidate = PolicyRun<HopPolicy>;
 
 /// The result of [`plan_hops`].
 #[derive(Clone, Debug)]
@@ -294,30 +269,10 @@ impl HopSearch<'_, '_> {
             self.timed_out = true;
             return false;
         }
-        let t = match trace.crossing {
-            Some(c) if trace.feasible() => c.time,
-            _ => return false,
-        };
-        if self.best.as_ref().is_some_and(|b| t >= b.time()) {
-            return false;
-        }
-        let engine_exact = self
-            .sim
-            .run_engine_exact_within(&trace.controls, &self.budget);
-        if engine_exact.interrupted {
-            self.timed_out = true;
-            return false;
-        }
-        let cand = HopCandidate {
-            policy,
-            trace,
-            engine_exact,
-        };
-        if !cand.valid() {
-            return false;
-        }
-        self.best = Some(cand);
-        true
+        let (kept, interrupted) =
+            keep_if_better(&mut self.best, self.sim, policy, trace, &self.budget);
+        self.timed_out |= interrupted;
+        kept
     }
 
     fn best_policy(&self, fallback: HopPolicy) -> HopPolicy {

@@ -37,13 +37,14 @@
 //! exactly what it claims; every yaw is put on an anglemod step (section 1) and the best plan is replayed
 //! in the engine-exact mode (f32) before it is accepted.
 
+use super::policy_run::{keep_if_better, PolicyRun};
 use super::search::{Quality, SearchSettings};
 use crate::budget::Budget;
 use crate::physics::engine_exact::quantise_yaw_rad;
 use crate::physics::strafe::{max_accel_control, strafe_keys};
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2};
 use crate::sim::abh::{boost_addition, jump_airtime_s, lane_centre_line, run_abh, AbhParams};
-use crate::sim::{Controller, EngineRun, Simulation, Trace};
+use crate::sim::{Controller, Simulation, Trace};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -322,31 +323,8 @@ impl Controller for JumpRunner {
     }
 }
 
-/// One evaluated candidate.
-#[derive(Clone, Debug)]
-pub struct Candidate {
-    /// The policy played.
-    pub policy: JumpPolicy,
-    /// Its run in `f64`.
-    pub trace: Trace,
-    /// Its controls replayed engine-exact.
-    pub engine_exact: EngineRun,
-}
-
-impl Candidate {
-    /// Valid in `f64` and in the engine-exact replay.
-    pub fn valid(&self) -> bool {
-        self.trace.feasible() && self.engine_exact.feasible()
-    }
-
-    /// The `f64` crossing time, seconds; infinite when not valid.
-    pub fn time(&self) -> f64 {
-        match self.trace.crossing {
-            Some(c) if self.valid() => c.time,
-            _ => f64::INFINITY,
-        }
-    }
-}
+/// One evaluated jump policy.
+pub type Candidate = PolicyRun<JumpPolicy>;
 
 /// The result of [`plan_jumps`].
 #[derive(Clone, Debug)]
@@ -387,31 +365,15 @@ impl Search<'_, '_, '_> {
 
     /// Keeps `trace` (played by `policy`) if it is valid in both arithmetics and better than the best.
     fn consider(&mut self, policy: JumpPolicy, trace: Trace) -> bool {
-        let t = match trace.crossing {
-            Some(c) if trace.feasible() => c.time,
-            _ => return false,
-        };
-        if self.best.as_ref().is_some_and(|b| t >= b.time()) {
-            return false;
-        }
         // The first valid run is verified whatever the budget, so there is always a result to return.
         let budget = if self.best.is_some() {
             self.budget
         } else {
             Budget::unlimited()
         };
-        let engine_exact = self.sim.run_engine_exact_within(&trace.controls, &budget);
-        self.timed_out |= engine_exact.interrupted;
-        let cand = Candidate {
-            policy,
-            trace,
-            engine_exact,
-        };
-        if !cand.valid() {
-            return false;
-        }
-        self.best = Some(cand);
-        true
+        let (kept, interrupted) = keep_if_better(&mut self.best, self.sim, policy, trace, &budget);
+        self.timed_out |= interrupted;
+        kept
     }
 
     fn best_policy(&self) -> JumpPolicy {

@@ -10,6 +10,7 @@ pub mod jumps;
 pub mod lagrangian;
 pub mod model;
 mod planner;
+mod policy_run;
 mod polish;
 pub mod qp;
 mod relaxed;
@@ -21,6 +22,7 @@ mod verify;
 
 pub use baseline::GreedyGuide;
 pub use bound::{lower_bound, LowerBound};
+pub use policy_run::PolicyRun;
 pub use relaxed::RelaxedCertificate;
 pub use search::{
     solve, solve_cancellable, solve_with_progress, Outcome, Progress, Quality, SearchSettings,
