@@ -158,11 +158,7 @@ fn max_accel_control_frames(st: &Stepper<f64>, state: &mut PlayerState, frames: 
 fn bench_max_accel_frames(c: &mut Criterion) {
     let vars = MovementVars::goldsrc(1000.0);
     let st: Stepper<f64> = Stepper::new(&vars, Effects::AIR_ONLY);
-    let k = by_hand::AirFrameConstants {
-        l: vars.air_speed_cap,
-        gamma1: vars.entity_friction * vars.frame_time_s() * vars.maxspeed * vars.airaccelerate,
-        tau: vars.frame_time_s(),
-    };
+    let k = by_hand::AirFrameConstants::of(&vars);
     let start = PlayerState::airborne(Vec2::ZERO, Vec2::new(320.0, 0.0));
     let mut g = c.benchmark_group("max_accel_frame");
     g.throughput(Throughput::Elements(FRAMES as u64));

@@ -15,11 +15,7 @@ use strafeopt::physics::{AccelLaw, Effects, MovementVars, PlayerState, Side, Ste
 fn settings() -> (Stepper<f64>, by_hand::AirFrameConstants, PlayerState) {
     let vars = MovementVars::goldsrc(1000.0);
     let st: Stepper<f64> = Stepper::new(&vars, Effects::AIR_ONLY);
-    let k = by_hand::AirFrameConstants {
-        l: vars.air_speed_cap,
-        gamma1: vars.entity_friction * vars.frame_time_s() * vars.maxspeed * vars.airaccelerate,
-        tau: vars.frame_time_s(),
-    };
+    let k = by_hand::AirFrameConstants::of(&vars);
     (
         st,
         k,

@@ -17,6 +17,17 @@ pub struct AirFrameConstants {
     pub tau: f64,
 }
 
+impl AirFrameConstants {
+    /// The constants of `vars` with the full strafe key held (`M` the max speed).
+    pub fn of(vars: &strafeopt::physics::MovementVars) -> Self {
+        AirFrameConstants {
+            l: vars.air_speed_cap,
+            gamma1: vars.entity_friction * vars.frame_time_s() * vars.maxspeed * vars.airaccelerate,
+            tau: vars.frame_time_s(),
+        }
+    }
+}
+
 /// Runs `frames` airborne maximum-acceleration frames turning left (anticlockwise) from `pos`, `vel`.
 /// Valid while `0 <= gamma1 <= L` (case 1) and the speed stays positive, which the bench settings keep.
 #[inline(never)]
