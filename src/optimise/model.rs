@@ -19,6 +19,8 @@ use crate::physics::{AccelLaw, Control, Vec2};
 
 /// One anglemod step of the yaw, radians (docs/physics.md section 1: `360 / 65536` degrees).
 const ANGLEMOD_STEP_RAD: f64 = std::f64::consts::TAU / 65536.0;
+/// The strongest braking a plan uses, as `-cos theta` of the strafe angle (see [`FrameLaw::c_min`]).
+const BRAKE_COS_LIMIT: f64 = 0.95;
 use std::ops::{Add, Div, Mul, Sub};
 
 /// The constants of one airborne frame: frame time and the acceleration law.
@@ -60,6 +62,13 @@ impl FrameLaw {
         } else {
             c
         }
+    }
+
+    /// The lowest `c` a plan uses at speed `v`, ups: braking down to `cos theta = -0.95`. Near
+    /// `theta = 180` degrees the lateral push `mu sqrt(V^2 - c^2) / V` has an unbounded derivative in `c`,
+    /// so a linearised frame there predicts nothing of what a small change of `c` does.
+    pub fn c_min(&self, v: f64) -> f64 {
+        -BRAKE_COS_LIMIT * v
     }
 
     /// `L - gamma1`, where the law's two pieces meet.
@@ -780,5 +789,23 @@ mod tests {
         let step = (360.0f64 / 65536.0).to_radians();
         assert!((fl.c_max(600.0) - 26.8).abs() < 1e-12);
         assert!((fl.c_max(600.0) - fl.c_plan_max(600.0) - 300.0 * step).abs() < 1e-12);
+    }
+
+    #[test]
+    fn braking_straight_back_is_linear_in_c_only_with_the_sides_cancelled() {
+        // At c = -V the heading's push mu sqrt(V^2 - c^2) / V has an unbounded derivative: one ups more
+        // of c swings a sided frame's heading by about 1e-3 rad, which its Jacobian does not see; with
+        // the sides cancelled (sigma = 0) the heading does not move and the Jacobian is right.
+        let (_, fl) = law(100.0);
+        let x = SAMPLE_STATE;
+        for (sigma, linear_holds) in [(0.0, true), (1.0, false)] {
+            let u = FrameControl { sigma, c: -x.speed };
+            let (y0, j) = frame(&x, u, &fl, true);
+            let Some(j) = j else { panic!("no Jacobian") };
+            let y1 = frame(&x, FrameControl { c: u.c + 1.0, ..u }, &fl, false).0;
+            let error = (y1.heading - y0.heading - j.b[3][1]).abs();
+            assert_eq!(error < 1e-6, linear_holds, "sigma {sigma}: error {error}");
+        }
+        assert!(fl.c_min(x.speed) > -x.speed);
     }
 }

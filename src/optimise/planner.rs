@@ -183,6 +183,13 @@ impl<'a> Planner<'a> {
             if fl.c_plan_max(v) < fl.c_max(v) {
                 u.c = u.c.min(fl.c_plan_max(v));
             }
+            // A greedy run brakes straight back (`c = -V`), beyond the plan's range, where the frame's
+            // heading is singular in `c` (`sqrt(V^2 - c^2)`): the relaxed frame there keeps its sides
+            // cancelled (`sigma = 0`, the same move) so that raising `c` into the range does not swing
+            // the heading by more than its linearisation sees.
+            if u.c < fl.c_min(v) {
+                u.sigma = 0.0;
+            }
             warm.push(u);
             vel = rec.vel;
         }
@@ -202,5 +209,45 @@ fn finish_direction(scene: &Scene, bound: &LowerBound) -> Vec2 {
         n
     } else {
         -n
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimise::baseline::baseline;
+    use crate::optimise::bound::lower_bound;
+    use crate::optimise::model::rollout;
+    use crate::scene::generate::{generate, GeneratorSettings};
+
+    #[test]
+    fn a_warm_start_braking_straight_back_cancels_its_sides_and_keeps_the_run() {
+        // Generated scene 12 of seed 11: 1472 ups into a turn, so the capped greedy runs brake first.
+        let g = generate(11, 12, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
+        let scene = g.scene;
+        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+        let corridor = scene.corridor().unwrap_or_else(|e| panic!("{e}"));
+        let bound = lower_bound(&scene, &corridor).unwrap_or_else(|e| panic!("{e}"));
+        let budget = Budget::unlimited();
+        let base = baseline(&sim, &scene, &bound, &budget);
+        let settings = SearchSettings::for_quality(crate::optimise::Quality::Fast);
+        let mut braked = 0;
+        for run in &base.clean {
+            let planner = Planner::new(&scene, &sim, &settings, &bound, &run.trace, budget);
+            let warm = planner.warm_start(&run.trace);
+            let states = rollout(&planner.start, &warm, &planner.fl);
+            let mut vel = scene.start.vel;
+            for (k, (u, rec)) in warm.iter().zip(&run.trace.frames).enumerate() {
+                let game = crate::optimise::model::frame_control_of(vel, &run.trace.controls[k]);
+                if game.c < planner.fl.c_min(vel.length()) {
+                    braked += 1;
+                    assert_eq!(u.sigma, 0.0, "frame {k}");
+                }
+                // The warm start is the run itself: the same path to within the model's rounding.
+                assert!((states[k].pos - rec.pos).length() < 0.5, "frame {k}");
+                vel = rec.vel;
+            }
+        }
+        assert!(braked > 0, "no clean run braked straight back");
     }
 }

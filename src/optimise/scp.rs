@@ -152,9 +152,9 @@ impl ScpProblem<'_> {
         }
     }
 
-    /// Lowest `c` allowed at speed `v`: braking down to `cos theta = -0.95`.
+    /// Lowest `c` allowed at speed `v` ([`FrameLaw::c_min`]).
     fn c_min(&self, v: f64) -> f64 {
-        -0.95 * v
+        self.fl.c_min(v)
     }
 }
 

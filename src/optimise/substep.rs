@@ -87,7 +87,7 @@ impl SubStepSetup {
                 SUBSTEP_SIGMA_TRUST.min(1.0 + u.sigma),
                 SUBSTEP_SIGMA_TRUST.min(1.0 - u.sigma),
             ));
-            let c_min = -0.95 * x.speed;
+            let c_min = fl.c_min(x.speed);
             c_range.push((
                 SUBSTEP_C_TRUST_UPS.min(u.c - c_min).max(0.0),
                 SUBSTEP_C_TRUST_UPS.min(fl.c_max(x.speed) - u.c).max(0.0),
