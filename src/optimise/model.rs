@@ -64,6 +64,26 @@ impl FrameLaw {
         }
     }
 
+    /// The largest `c` a plan with exact sides uses at speed `v`, ups. With its side fixed, a frame turns
+    /// less than the maximum-acceleration turn only with a larger `c` (and gains less speed): one such
+    /// frame shifts the phase of the alternating sides where they meet a turn, which the relaxed problem
+    /// (sides in between) needs no frame for. In case 2 (`gamma1 > L`, `c_max = 0`) the piece
+    /// `mu = L - c` runs on from `c_max` to `L`, where the frame coasts; the plan stops at `min(L, 0.95 V)`,
+    /// as far from `theta = 0` as [`FrameLaw::c_min`] is from 180 degrees. In case 1 `c_max` is the kink
+    /// the anglemod guard keeps the plan under, and the range ends at [`FrameLaw::c_plan_max`].
+    pub fn c_exact_max(&self, v: f64) -> f64 {
+        if self.exact_sides_turn_less() {
+            self.law.l.min(BRAKE_COS_LIMIT * v).max(self.c_max(v))
+        } else {
+            self.c_plan_max(v)
+        }
+    }
+
+    /// Whether [`FrameLaw::c_exact_max`] reaches above `c_max`: in the law's second case only.
+    pub fn exact_sides_turn_less(&self) -> bool {
+        self.law.gamma1 > self.law.l
+    }
+
     /// The lowest `c` a plan uses at speed `v`, ups: braking down to `cos theta = -0.95`. Near
     /// `theta = 180` degrees the lateral push `mu sqrt(V^2 - c^2) / V` has an unbounded derivative in `c`,
     /// so a linearised frame there predicts nothing of what a small change of `c` does.
@@ -807,5 +827,25 @@ mod tests {
             assert_eq!(error < 1e-6, linear_holds, "sigma {sigma}: error {error}");
         }
         assert!(fl.c_min(x.speed) > -x.speed);
+    }
+
+    #[test]
+    fn exact_sides_may_turn_less_than_maximum_acceleration_only_in_case_2() {
+        // Case 2 (100 fps): c runs on past c_max = 0 to L = 30, where the frame coasts; below L / 0.95
+        // ups it stops at 0.95 V, clear of theta = 0.
+        let (_, fl) = law(100.0);
+        assert_eq!(fl.c_exact_max(600.0), 30.0);
+        assert!((fl.c_exact_max(20.0) - 19.0).abs() < 1e-12);
+        // Each step of c above c_max turns less and gains less: it is the turn-less piece, not a better
+        // maximum.
+        let x = SAMPLE_STATE;
+        let at = |c: f64| frame(&x, FrameControl { sigma: 1.0, c }, &fl, false).0;
+        let (max, less, coast) = (at(fl.c_max(x.speed)), at(15.0), at(fl.c_exact_max(x.speed)));
+        assert!(less.heading - x.heading < max.heading - x.heading);
+        assert!(less.speed < max.speed && less.heading > x.heading);
+        assert!((coast.heading - x.heading).abs() < 1e-12 && (coast.speed - x.speed).abs() < 1e-9);
+        // Case 1 (1000 fps): c_max is the kink, and exact sides keep under the anglemod guard.
+        let (_, fl) = law(1000.0);
+        assert_eq!(fl.c_exact_max(600.0), fl.c_plan_max(600.0));
     }
 }

@@ -109,6 +109,7 @@ impl<'a> Planner<'a> {
             relaxed,
             frames_per_knot,
             anglemod_guard: true,
+            turn_less: false,
         }
     }
 

@@ -6,7 +6,7 @@
 use super::model::{rollout, FrameControl};
 use super::planner::Planner;
 use super::rounding::round_sides;
-use super::scp::{model_crossing, CLEAN_VIOLATION_UNITS};
+use super::scp::{model_crossing, ScpProblem, CLEAN_VIOLATION_UNITS};
 use crate::budget::Stage;
 
 /// Times the relaxed plan is re-solved with a wider margin when rounding leaves the walls.
@@ -33,8 +33,7 @@ pub(super) fn rounded_and_polished(
             break;
         };
         if planner.settings.polish_iters > 0 && !planner.timed_out {
-            let pr = planner.problem(final_margin, false, 1);
-            exact = planner.stage(pr, exact, planner.settings.polish_iters).0;
+            exact = polished(planner, exact, final_margin);
         }
         let st = rollout(&planner.start, &exact, &fl);
         let clean = planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS;
@@ -48,6 +47,25 @@ pub(super) fn rounded_and_polished(
         relaxed = resolved_wider(planner, relaxed, margin);
     }
     candidates
+}
+
+/// `exact` with its sides fixed and `c` polished at `margin`: first with every frame at most at the
+/// maximum-acceleration turn, as the relaxed plan it was rounded from, then on from there with frames that
+/// may turn less ([`super::model::FrameLaw::c_exact_max`]), which moves the sides' phase where they meet a
+/// turn. The second stage starts from the first's plan, so it only keeps what improves on it; in the law's
+/// first case there is no such frame and no second stage.
+fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Vec<FrameControl> {
+    let iters = planner.settings.polish_iters;
+    let pr = planner.problem(margin, false, 1);
+    let exact = planner.stage(pr, exact, iters).0;
+    if planner.timed_out || !planner.fl.exact_sides_turn_less() {
+        return exact;
+    }
+    let pr = ScpProblem {
+        turn_less: true,
+        ..planner.problem(margin, false, 1)
+    };
+    planner.stage(pr, exact, iters).0
 }
 
 /// The relaxed plan re-solved at the wider `margin`, cut at its crossing, or one frame longer when it no

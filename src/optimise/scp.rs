@@ -42,6 +42,9 @@ pub struct ScpProblem<'a> {
     /// Whether `c` stays under the anglemod guard of the law's first case ([`FrameLaw::c_plan_max`]);
     /// off for the relaxed certificate, whose feasible set must hold every exact plan.
     pub(super) anglemod_guard: bool,
+    /// With exact sides, whether a frame may turn less than the maximum-acceleration turn
+    /// ([`FrameLaw::c_exact_max`]); else `c` keeps under the guard as in the relaxed problem.
+    pub(super) turn_less: bool,
 }
 
 /// The trajectory of a parameter vector with what the sub-problem needs.
@@ -143,9 +146,12 @@ impl ScpProblem<'_> {
         }
     }
 
-    /// Highest `c` allowed at speed `v`, ups.
+    /// Highest `c` allowed at speed `v`, ups: [`FrameLaw::c_exact_max`] for exact sides that may turn
+    /// less; else [`FrameLaw::c_max`], under the anglemod guard when it is on.
     fn c_upper(&self, v: f64) -> f64 {
-        if self.anglemod_guard {
+        if self.turn_less && !self.relaxed {
+            self.fl.c_exact_max(v)
+        } else if self.anglemod_guard {
             self.fl.c_plan_max(v)
         } else {
             self.fl.c_max(v)
