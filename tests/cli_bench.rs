@@ -98,3 +98,57 @@ fn bench_refuses_bad_input_in_one_line() {
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.starts_with("strafeopt: "), "{err}");
 }
+
+#[test]
+fn staircase_rows_are_valid_and_grow_with_the_corners() {
+    let out = Command::cargo_bin("strafeopt")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .args(["bench", "--staircase", "1,2", "--json"])
+        .output()
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(v["quality"], "fast");
+    let rows = v["scenes"]
+        .as_array()
+        .unwrap_or_else(|| panic!("a record per staircase"));
+    let frames: Vec<u64> = rows
+        .iter()
+        .map(|r| {
+            assert_eq!(r["valid"], true, "{r}");
+            assert_eq!(r["engine_exact_valid"], true, "{r}");
+            let (f, b) = (r["frames"].as_u64(), r["bound_frames"].as_u64());
+            let (Some(f), Some(b)) = (f, b) else {
+                panic!("no frames in {r}")
+            };
+            assert!(f >= b, "{r}");
+            assert!(r["greedy_frames"].as_u64().is_some_and(|g| g >= f), "{r}");
+            f
+        })
+        .collect();
+    assert_eq!(
+        rows.iter()
+            .map(|r| r["corners"].as_u64())
+            .collect::<Vec<_>>(),
+        [Some(1), Some(2)]
+    );
+    // A second corner adds a 600-unit leg: at several hundred ups, more than half a second.
+    assert!(frames[1] > frames[0] + 50, "{frames:?}");
+}
+
+#[test]
+fn a_staircase_with_no_corners_is_refused_in_one_line() {
+    let out = Command::cargo_bin("strafeopt")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .args(["bench", "--staircase", "0"])
+        .output()
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("1 to 64"), "{err}");
+}

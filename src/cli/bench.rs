@@ -1,7 +1,8 @@
 //! `strafeopt bench`: what accuracy costs in time. Loads the scenes, runs
 //! [`crate::bench::measure_scene`] on each and [`crate::bench::measure_scaling`] on the first, and prints
 //! an aligned table or (`--json`) one array of rows; `--svg` writes gap against wall time. With
-//! `--generated N` it solves N generated scenes instead ([`super::bench_generated`]).
+//! `--generated N` it solves N generated scenes instead ([`super::bench_generated`]), with
+//! `--staircase C,...` staircases of C corners ([`super::bench_staircase`]).
 
 use super::args::QualityArg;
 use super::{progress, write_atomically};
@@ -64,8 +65,13 @@ pub struct BenchArgs {
     /// files, and print the distribution of their results.
     #[arg(long, allow_negative_numbers = true)]
     pub generated: Option<i64>,
-    /// Quality of each solve with --generated (default fast).
-    #[arg(long, value_enum, requires = "generated")]
+    /// Solve staircases of these corner counts instead of scene files (right-angle turns alternating
+    /// left and right, 600-unit legs, 128 units wide, 100 fps, airborne at 400 ups), one row each: how
+    /// solve time grows with the corners alone.
+    #[arg(long, value_delimiter = ',', num_args = 1.., conflicts_with = "generated")]
+    pub staircase: Vec<u32>,
+    /// Quality of each solve with --generated or --staircase (default fast).
+    #[arg(long, value_enum, required = false)]
     pub quality: Option<QualityArg>,
     /// With --generated: flags that narrow the family, as for `strafeopt gen`.
     #[command(flatten)]
@@ -97,6 +103,17 @@ fn bend_width(path: &Path) -> Option<f64> {
 pub fn run(args: &BenchArgs) -> Result<String> {
     if args.generated.is_some() {
         return super::bench_generated::run(args);
+    }
+    if !args.staircase.is_empty() {
+        return super::bench_staircase::run(args);
+    }
+    if args.quality.is_some() {
+        return Err(Error::InvalidValue {
+            name: "--quality".to_string(),
+            value: "given for scene files".to_string(),
+            allowed: "given with --generated or --staircase (for scene files, --levels)"
+                .to_string(),
+        });
     }
     if let Some(flag) = args.family.first_given() {
         return Err(Error::InvalidValue {

@@ -6,6 +6,7 @@
 pub mod args;
 pub mod bench;
 pub mod bench_generated;
+pub mod bench_staircase;
 pub mod calc;
 pub mod check;
 pub mod gen;

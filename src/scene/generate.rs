@@ -40,9 +40,11 @@
 
 mod centreline;
 mod rng;
+mod staircase;
 
 pub use centreline::{CentrelinePiece, Side};
 pub use rng::SplitMix64;
+pub use staircase::{staircase, Staircase, MAX_STAIRCASE_CORNERS};
 
 use super::{Scene, START_OFFSET_UNITS};
 use crate::error::{Error, Result};
@@ -503,7 +505,9 @@ pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<G
             corridor_draws: draw,
         };
         let name = format!("gen-{seed}-{index}");
-        let toml = scene_text(&name, seed, index, settings, &drawn, &layout);
+        let header = header_comment(seed, index, settings, &drawn);
+        let origin = format!("Generated (seed {seed}, scene {index})");
+        let toml = scene_text(&name, &header, &origin, &drawn, &layout);
         let scene = Scene::from_toml_str(&toml, &format!("{name}.toml"))?;
         return Ok(GeneratedScene {
             seed,
@@ -635,17 +639,17 @@ fn header_comment(seed: u64, index: u64, settings: &GeneratorSettings, d: &Drawn
     s
 }
 
-/// The scene file: the leading comment, then the scene with explicit walls.
+/// The scene file: the leading comment `header`, then the scene with explicit walls; its description
+/// starts with `origin`.
 fn scene_text(
     name: &str,
-    seed: u64,
-    index: u64,
-    settings: &GeneratorSettings,
+    header: &str,
+    origin: &str,
     d: &Drawn,
     layout: &centreline::Layout,
 ) -> String {
     let corners = d.turns.len();
-    let mut s = header_comment(seed, index, settings, d);
+    let mut s = header.to_string();
     let _ = writeln!(s, "name = \"{name}\"");
     let start_words = match d.kind {
         SceneKind::Air => "airborne at",
@@ -655,7 +659,7 @@ fn scene_text(
     };
     let _ = writeln!(
         s,
-        "description = \"Generated (seed {seed}, scene {index}): {}, {} fps, sv_airaccelerate {}, {start_words} \
+        "description = \"{origin}: {}, {} fps, sv_airaccelerate {}, {start_words} \
          {} ups; {corners} turns ({}), {} units wide, {} walls\"",
         d.kind.engine(),
         d.fps,
