@@ -4,7 +4,9 @@
 
 use super::bench::{quality, BenchArgs};
 use super::gen::checked_count;
-use crate::bench::generated::{columns, distributions, measure_generated, share, Distribution};
+use crate::bench::generated::{
+    columns, distributions, measure_generated, share, Distribution, SceneRecord,
+};
 use crate::bench::quality_name;
 use crate::error::{Error, Result};
 use crate::optimise::search::time_limit;
@@ -46,18 +48,7 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     let limit = args.time_limit.map(time_limit).transpose()?;
     let scenes = generate_sample(seed, count, &settings)?;
     let show = std::io::stderr().is_terminal() && !args.json;
-    let records = measure_generated(&scenes, q, limit, &mut |i, r| {
-        if show {
-            eprintln!(
-                "[{}/{count}] {}: {} frames, {:.1} s, {}",
-                i + 1,
-                r.scene,
-                r.frames.map_or("-".to_string(), |f| f.to_string()),
-                r.solve_seconds,
-                r.status
-            );
-        }
-    });
+    let records = measure_generated(&scenes, q, limit, &mut progress_lines(show, count));
     let dist = distributions(&records, &columns());
     let greedy = share(&records, |r| r.greedy_valid);
     let plan = share(&records, |r| r.valid);
@@ -94,6 +85,23 @@ pub fn run(args: &BenchArgs) -> Result<String> {
         pct(exact)
     ));
     Ok(out)
+}
+
+/// What `bench` prints on stderr as each of `count` scenes is solved (nothing unless `show`): its place,
+/// name, frames, solve time and status.
+pub fn progress_lines(show: bool, count: u64) -> impl FnMut(usize, &SceneRecord) {
+    move |i, r| {
+        if show {
+            eprintln!(
+                "[{}/{count}] {}: {} frames, {:.1} s, {}",
+                i + 1,
+                r.scene,
+                r.frames.map_or("-".to_string(), |f| f.to_string()),
+                r.solve_seconds,
+                r.status
+            );
+        }
+    }
 }
 
 /// The distributions as an aligned table, one row per column.

@@ -3,6 +3,7 @@
 //! one object with a record per staircase ([`crate::bench::generated::SceneRecord`]).
 
 use super::bench::{quality, BenchArgs};
+use super::bench_generated::progress_lines;
 use crate::bench::generated::{measure_generated, SceneRecord};
 use crate::bench::quality_name;
 use crate::error::{Error, Result};
@@ -39,19 +40,8 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     let q = args.quality.map_or(Quality::Fast, quality);
     let limit = args.time_limit.map(time_limit).transpose()?;
     let show = std::io::stderr().is_terminal() && !args.json && !args.quiet;
-    let count = scenes.len();
-    let records = measure_generated(&scenes, q, limit, &mut |i, r| {
-        if show {
-            eprintln!(
-                "[{}/{count}] {}: {} frames, {:.1} s, {}",
-                i + 1,
-                r.scene,
-                r.frames.map_or("-".to_string(), |f| f.to_string()),
-                r.solve_seconds,
-                r.status
-            );
-        }
-    });
+    let count = scenes.len() as u64;
+    let records = measure_generated(&scenes, q, limit, &mut progress_lines(show, count));
     if args.json {
         let value = serde_json::json!({
             "quality": quality_name(q),

@@ -475,15 +475,9 @@ pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<G
 
     for draw in 1..=settings.max_corridor_draws {
         let (turns, legs_units) = draw_corridor(&mut rng, corners, settings);
-        let layout = lay_out(&Shape {
-            width_units: width,
-            gap_units: gap,
-            legs_units: &legs_units,
-            turns: &turns,
-        });
-        if overlaps_itself(&layout.pieces, width, gap) {
+        let Some(layout) = clear_layout(width, gap, &legs_units, &turns) else {
             continue;
-        }
+        };
         let kind = pick(&mut rng, &settings.kinds)?;
         let start_speed_ups = if kind.on_ground() {
             ground_start_speed(&mut rng, settings)
@@ -526,6 +520,23 @@ pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<G
             settings.max_corridor_draws
         ),
     })
+}
+
+/// The corridor of `legs_units` and `turns`, `width` wide with dividers `gap` thick (units), laid out;
+/// `None` when it overlaps itself.
+fn clear_layout(
+    width: f64,
+    gap: f64,
+    legs_units: &[u32],
+    turns: &[(u32, Side)],
+) -> Option<centreline::Layout> {
+    let layout = lay_out(&Shape {
+        width_units: width,
+        gap_units: gap,
+        legs_units,
+        turns,
+    });
+    (!overlaps_itself(&layout.pieces, width, gap)).then_some(layout)
 }
 
 /// One draw of a corridor: each turn's angle and side, then each leg's length (one more than the turns).

@@ -7,8 +7,8 @@
 //! the start is airborne [`crate::scene::START_OFFSET_UNITS`] into the first leg on its centre line, moving along it;
 //! the finish line spans the last leg's end. The first turn is to the left.
 
-use super::centreline::{lay_out, overlaps_itself, Shape, Side};
-use super::{scene_text, Drawn, GeneratedScene, GeneratorSettings, SceneKind, Turn};
+use super::centreline::Side;
+use super::{clear_layout, scene_text, Drawn, GeneratedScene, GeneratorSettings, SceneKind, Turn};
 use crate::error::{Error, Result};
 use crate::geometry::BoundaryKind;
 use crate::scene::Scene;
@@ -84,13 +84,7 @@ pub fn staircase(spec: &Staircase) -> Result<GeneratedScene> {
         f64::from(spec.width_units),
         f64::from(GeneratorSettings::default().wall_gap_units),
     );
-    let layout = lay_out(&Shape {
-        width_units: width,
-        gap_units: gap,
-        legs_units: &legs_units,
-        turns: &turns,
-    });
-    if overlaps_itself(&layout.pieces, width, gap) {
+    let Some(layout) = clear_layout(width, gap, &legs_units, &turns) else {
         return Err(Error::InvalidValue {
             name: "staircase width".to_string(),
             value: spec.width_units.to_string(),
@@ -99,7 +93,7 @@ pub fn staircase(spec: &Staircase) -> Result<GeneratedScene> {
                 spec.leg_units
             ),
         });
-    }
+    };
     let drawn = Drawn {
         width_units: spec.width_units,
         legs_units,
