@@ -67,21 +67,24 @@ impl FrameLaw {
     /// The largest `c` a plan with exact sides uses at speed `v`, ups. With its side fixed, a frame turns
     /// less than the maximum-acceleration turn only with a larger `c` (and gains less speed): one such
     /// frame shifts the phase of the alternating sides where they meet a turn, which the relaxed problem
-    /// (sides in between) needs no frame for. In case 2 (`gamma1 > L`, `c_max = 0`) the piece
-    /// `mu = L - c` runs on from `c_max` to `L`, where the frame coasts; the plan stops at `min(L, 0.95 V)`,
-    /// as far from `theta = 0` as [`FrameLaw::c_min`] is from 180 degrees. In case 1 `c_max` is the kink
-    /// the anglemod guard keeps the plan under, and the range ends at [`FrameLaw::c_plan_max`].
+    /// (sides in between) needs no frame for. The piece `mu = L - c` runs on from `c_max` to `L`, where the
+    /// frame coasts; the plan stops at `min(L, 0.95 V)`, as far from `theta = 0` as [`FrameLaw::c_min`] is
+    /// from 180 degrees. In case 1 the range passes the kink, which a plan then keeps clear of
+    /// ([`FrameLaw::under_the_guard`]).
     pub fn c_exact_max(&self, v: f64) -> f64 {
-        if self.exact_sides_turn_less() {
-            self.law.l.min(BRAKE_COS_LIMIT * v).max(self.c_max(v))
-        } else {
-            self.c_plan_max(v)
-        }
+        self.law.l.min(BRAKE_COS_LIMIT * v).max(self.c_max(v))
     }
 
-    /// Whether [`FrameLaw::c_exact_max`] reaches above `c_max`: in the law's second case only.
-    pub fn exact_sides_turn_less(&self) -> bool {
-        self.law.gamma1 > self.law.l
+    /// `c` at speed `v` kept out of the anglemod guard's band around the kink in case 1: a `c` above
+    /// [`FrameLaw::c_plan_max`] but less than as far above the kink goes down to `c_plan_max` (the frame
+    /// then gains what the guarded plan counts on); every other `c`, and every `c` in case 2, is kept.
+    pub fn under_the_guard(&self, c: f64, v: f64) -> f64 {
+        let (guard, kink) = (self.c_plan_max(v), self.kink());
+        if guard < kink && c > guard && c < 2.0 * kink - guard {
+            guard
+        } else {
+            c
+        }
     }
 
     /// The lowest `c` a plan uses at speed `v`, ups: braking down to `cos theta = -0.95`. Near
@@ -830,7 +833,7 @@ mod tests {
     }
 
     #[test]
-    fn exact_sides_may_turn_less_than_maximum_acceleration_only_in_case_2() {
+    fn exact_sides_may_turn_less_than_maximum_acceleration_clear_of_the_guard() {
         // Case 2 (100 fps): c runs on past c_max = 0 to L = 30, where the frame coasts; below L / 0.95
         // ups it stops at 0.95 V, clear of theta = 0.
         let (_, fl) = law(100.0);
@@ -844,8 +847,16 @@ mod tests {
         assert!(less.heading - x.heading < max.heading - x.heading);
         assert!(less.speed < max.speed && less.heading > x.heading);
         assert!((coast.heading - x.heading).abs() < 1e-12 && (coast.speed - x.speed).abs() < 1e-9);
-        // Case 1 (1000 fps): c_max is the kink, and exact sides keep under the anglemod guard.
+        // Case 1 (1000 fps): c_max is the kink. Exact sides may turn less past it, but not stay within
+        // the guard's band around it.
         let (_, fl) = law(1000.0);
-        assert_eq!(fl.c_exact_max(600.0), fl.c_plan_max(600.0));
+        assert_eq!(fl.c_exact_max(600.0), 30.0);
+        let (guard, kink) = (fl.c_plan_max(600.0), fl.kink());
+        assert_eq!(fl.under_the_guard(kink, 600.0), guard);
+        assert_eq!(fl.under_the_guard(guard + 1e-9, 600.0), guard);
+        assert_eq!(fl.under_the_guard(guard - 1.0, 600.0), guard - 1.0);
+        assert_eq!(fl.under_the_guard(kink + 1.0, 600.0), kink + 1.0);
+        let (_, fl) = law(100.0);
+        assert_eq!(fl.under_the_guard(0.0, 600.0), 0.0);
     }
 }

@@ -3,7 +3,7 @@
 //! ran closer than the rounded zigzag allows), the relaxed plan is re-solved at the same frame count with a
 //! wider margin and rounded again.
 
-use super::model::{rollout, FrameControl};
+use super::model::{frame, rollout, FrameControl};
 use super::planner::Planner;
 use super::rounding::round_sides;
 use super::scp::{model_crossing, ScpProblem, CLEAN_VIOLATION_UNITS};
@@ -15,7 +15,8 @@ const MARGIN_RETRIES: usize = 3;
 const MARGIN_GROWTH: f64 = 2.5;
 
 /// Exact-side plans from `relaxed` (solved at `relaxed_margin`, units), polished at `final_margin`: the
-/// first that is clear and reaches the line, after the plans of each wider-margin retry that were not.
+/// plans of the first rounding with one that is clear and reaches the line, after those of each
+/// wider-margin retry that had none.
 pub(super) fn rounded_and_polished(
     planner: &mut Planner,
     relaxed: &[FrameControl],
@@ -27,20 +28,27 @@ pub(super) fn rounded_and_polished(
     let mut relaxed = relaxed.to_vec();
     let mut margin = relaxed_margin;
     for attempt in 0..=MARGIN_RETRIES {
-        let Some(mut exact) = round_sides(&planner.start, &relaxed, &fl, &planner.budget) else {
+        let Some(exact) = round_sides(&planner.start, &relaxed, &fl, &planner.budget) else {
             planner.timed_out = true;
             planner.note_cut(Stage::Rounding);
             break;
         };
-        if planner.settings.polish_iters > 0 && !planner.timed_out {
-            exact = polished(planner, exact, final_margin);
+        let plans = if planner.settings.polish_iters > 0 && !planner.timed_out {
+            polished(planner, exact, final_margin)
+        } else {
+            vec![exact]
+        };
+        let mut clear_and_reaching = false;
+        for plan in plans {
+            let st = rollout(&planner.start, &plan, &fl);
+            let clean =
+                planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS;
+            clear_and_reaching |=
+                clean && model_crossing(&planner.start, &st, planner.scene).is_some();
+            candidates.push(plan);
         }
-        let st = rollout(&planner.start, &exact, &fl);
-        let clean = planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS;
-        let reaches = model_crossing(&planner.start, &st, planner.scene).is_some();
-        candidates.push(exact);
         planner.note_cut(Stage::Rounding);
-        if (clean && reaches) || attempt == MARGIN_RETRIES || planner.timed_out {
+        if clear_and_reaching || attempt == MARGIN_RETRIES || planner.timed_out {
             break;
         }
         margin = (margin * MARGIN_GROWTH).max(final_margin * MARGIN_GROWTH);
@@ -49,23 +57,35 @@ pub(super) fn rounded_and_polished(
     candidates
 }
 
-/// `exact` with its sides fixed and `c` polished at `margin`: first with every frame at most at the
-/// maximum-acceleration turn, as the relaxed plan it was rounded from, then on from there with frames that
-/// may turn less ([`super::model::FrameLaw::c_exact_max`]), which moves the sides' phase where they meet a
-/// turn. The second stage starts from the first's plan, so it only keeps what improves on it; in the law's
-/// first case there is no such frame and no second stage.
-fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Vec<FrameControl> {
+/// `exact` with its sides fixed and `c` polished at `margin`, as two plans: first with every frame at most
+/// at the maximum-acceleration turn, as the relaxed plan it was rounded from; then, on from that, with
+/// frames that may turn less ([`super::model::FrameLaw::c_exact_max`]), which moves the sides' phase where
+/// they meet a turn. In the law's first case the second plan's frames left within the anglemod guard's
+/// band go back under it ([`super::model::FrameLaw::under_the_guard`]), which the model does not see, so
+/// both plans go on to be quantised and replayed, and the faster valid one is kept.
+fn polished(
+    planner: &mut Planner,
+    exact: Vec<FrameControl>,
+    margin: f64,
+) -> Vec<Vec<FrameControl>> {
     let iters = planner.settings.polish_iters;
     let pr = planner.problem(margin, false, 1);
     let exact = planner.stage(pr, exact, iters).0;
-    if planner.timed_out || !planner.fl.exact_sides_turn_less() {
-        return exact;
+    if planner.timed_out {
+        return vec![exact];
     }
     let pr = ScpProblem {
         turn_less: true,
         ..planner.problem(margin, false, 1)
     };
-    planner.stage(pr, exact, iters).0
+    let mut turned = planner.stage(pr, exact.clone(), iters).0;
+    let fl = planner.fl;
+    let mut x = planner.start;
+    for u in turned.iter_mut() {
+        u.c = fl.under_the_guard(u.c, x.speed);
+        x = frame(&x, *u, &fl, false).0;
+    }
+    vec![turned, exact]
 }
 
 /// The relaxed plan re-solved at the wider `margin`, cut at its crossing, or one frame longer when it no
