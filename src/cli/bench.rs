@@ -5,6 +5,7 @@
 //! `--staircase C,...` staircases of C corners ([`super::bench_staircase`]).
 
 use super::args::QualityArg;
+use super::table::{aligned_line, column_widths};
 use super::{progress, write_atomically};
 use crate::bench::{
     measure_scaling, measure_scene, quality_name, write_accuracy_svg, BenchRow, BenchSettings,
@@ -240,29 +241,12 @@ pub fn table(rows: &[BenchRow]) -> String {
             notes,
         ]);
     }
-    let mut widths = header.map(str::len);
-    for c in &cells {
-        for (w, s) in widths.iter_mut().zip(c) {
-            *w = (*w).max(s.chars().count());
-        }
-    }
     // Text columns left-aligned, numbers right-aligned; the notes column is not padded.
-    let numeric = [
+    let right_aligned = [
         false, true, false, false, true, true, true, false, true, true, true, false,
     ];
-    let line = |c: &[String]| {
-        let mut s = String::new();
-        for (i, v) in c.iter().enumerate() {
-            if i + 1 == c.len() {
-                s.push_str(v);
-            } else if numeric[i] {
-                s.push_str(&format!("{v:>w$}  ", w = widths[i]));
-            } else {
-                s.push_str(&format!("{v:<w$}  ", w = widths[i]));
-            }
-        }
-        s.trim_end().to_string() + "\n"
-    };
+    let widths = column_widths(&header, &cells);
+    let line = |c: &[String]| aligned_line(c, &widths, &right_aligned);
     let mut out = String::new();
     for (title, section) in [
         ("accuracy against time", Section::Accuracy),

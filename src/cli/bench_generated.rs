@@ -4,6 +4,7 @@
 
 use super::bench::{quality, BenchArgs};
 use super::gen::checked_count;
+use super::table::aligned_table;
 use crate::bench::generated::{
     columns, distributions, measure_generated, share, Distribution, SceneRecord,
 };
@@ -121,22 +122,5 @@ pub fn table(dist: &[Distribution]) -> String {
             ]
         })
         .collect();
-    let mut widths = header.map(str::len);
-    for r in &rows {
-        for (w, c) in widths.iter_mut().zip(r) {
-            *w = (*w).max(c.len());
-        }
-    }
-    let line = |cells: &[String]| {
-        let mut s = format!("{:<w$}", cells[0], w = widths[0]);
-        for (c, w) in cells.iter().zip(widths).skip(1) {
-            s.push_str(&format!("  {c:>w$}"));
-        }
-        s + "\n"
-    };
-    let mut out = line(&header.map(String::from));
-    for r in &rows {
-        out.push_str(&line(r));
-    }
-    out
+    aligned_table(&header, &rows, &[false, true, true, true, true, true])
 }

@@ -4,6 +4,7 @@
 
 use super::bench::{quality, BenchArgs};
 use super::bench_generated::progress_lines;
+use super::table::aligned_table;
 use crate::bench::generated::{measure_generated, SceneRecord};
 use crate::bench::quality_name;
 use crate::error::{Error, Result};
@@ -80,8 +81,7 @@ fn table(records: &[SceneRecord]) -> String {
         "solve (s)",
         "ms/frame",
         "status",
-    ]
-    .map(String::from);
+    ];
     let opt = |v: Option<u64>| v.map_or("-".to_string(), |x| x.to_string());
     let rows: Vec<[String; 9]> = records
         .iter()
@@ -105,26 +105,7 @@ fn table(records: &[SceneRecord]) -> String {
             ]
         })
         .collect();
-    let mut widths = header.clone().map(|h| h.len());
-    for r in &rows {
-        for (w, c) in widths.iter_mut().zip(r) {
-            *w = (*w).max(c.len());
-        }
-    }
-    let line = |cells: &[String]| {
-        let mut s = String::new();
-        for (i, (c, w)) in cells.iter().zip(widths).enumerate() {
-            if i + 1 == cells.len() {
-                s.push_str(c);
-            } else {
-                s.push_str(&format!("{c:>w$}  "));
-            }
-        }
-        s.trim_end().to_string() + "\n"
-    };
-    let mut out = line(&header);
-    for r in &rows {
-        out.push_str(&line(r));
-    }
-    out
+    let mut right_aligned = [true; 9];
+    right_aligned[8] = false;
+    aligned_table(&header, &rows, &right_aligned)
 }

@@ -15,6 +15,7 @@ pub mod report_cmd;
 pub mod serve;
 pub mod simulate;
 pub mod solve;
+pub mod table;
 
 use crate::error::Error;
 use args::{Cli, Command};

@@ -87,6 +87,12 @@ impl FrameLaw {
         }
     }
 
+    /// Whether the law is in its first case (`gamma1 <= L`), where the maximum-acceleration `c` is the
+    /// kink and [`FrameLaw::c_plan_max`] keeps plans half an anglemod step under it.
+    pub fn has_kink_guard(&self) -> bool {
+        self.law.gamma1 <= self.law.l
+    }
+
     /// The lowest `c` a plan uses at speed `v`, ups: braking down to `cos theta = -0.95`. Near
     /// `theta = 180` degrees the lateral push `mu sqrt(V^2 - c^2) / V` has an unbounded derivative in `c`,
     /// so a linearised frame there predicts nothing of what a small change of `c` does.

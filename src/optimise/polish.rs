@@ -80,12 +80,18 @@ fn polished(
     };
     let mut turned = planner.stage(pr, exact.clone(), iters).0;
     let fl = planner.fl;
-    let mut x = planner.start;
-    for u in turned.iter_mut() {
-        u.c = fl.under_the_guard(u.c, x.speed);
-        x = frame(&x, *u, &fl, false).0;
+    if fl.has_kink_guard() {
+        let mut x = planner.start;
+        for u in turned.iter_mut() {
+            u.c = fl.under_the_guard(u.c, x.speed);
+            x = frame(&x, *u, &fl, false).0;
+        }
     }
-    vec![turned, exact]
+    if turned == exact {
+        vec![exact]
+    } else {
+        vec![turned, exact]
+    }
 }
 
 /// The relaxed plan re-solved at the wider `margin`, cut at its crossing, or one frame longer when it no
