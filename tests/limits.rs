@@ -217,6 +217,48 @@ fn a_set_cancel_flag_returns_the_best_valid_plan_and_names_the_stage() {
 }
 
 #[test]
+fn a_higher_level_cut_after_the_cheaper_one_keeps_the_cheaper_plan() {
+    let scene = Scene::from_toml_str(&shipped("hl-bend90-100fps"), "bend")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let fast = solve_cancellable(
+        &scene,
+        &SearchSettings::for_quality(Quality::Fast),
+        &mut |_| {},
+        &AtomicBool::new(false),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(fast.source, "optimised");
+    // `balanced` runs `fast` first: cancelled as the second level's baseline is ready, it keeps fast's
+    // plan (which `balanced` itself would beat) and says it was cut.
+    let cancel = AtomicBool::new(false);
+    let mut baselines = 0;
+    let o = solve_cancellable(
+        &scene,
+        &SearchSettings::for_quality(Quality::Balanced),
+        &mut |p| {
+            if matches!(p, Progress::Baseline { .. }) {
+                baselines += 1;
+                if baselines == 2 {
+                    cancel.store(true, Ordering::Relaxed);
+                }
+            }
+        },
+        &cancel,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(baselines, 2);
+    assert_eq!(o.source, "optimised");
+    assert_eq!(o.trace.crossing, fast.trace.crossing, "fast's plan");
+    assert_eq!(
+        o.status,
+        SearchStatus::Cancelled {
+            stopped_in: Stage::Relaxed
+        }
+    );
+    assert!(o.trace.feasible() && o.engine_exact.feasible());
+}
+
+#[test]
 fn text_output_has_fixed_decimals_in_one_column_and_no_progress_off_a_terminal() {
     let out = strafeopt(&[
         "solve",

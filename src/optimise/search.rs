@@ -265,9 +265,10 @@ pub fn solve(scene: &Scene, settings: &SearchSettings) -> Result<Outcome> {
 
 /// [`solve`], reporting what it does to `progress`.
 ///
-/// On airborne scenes a level also runs the levels below it in the time left (`exact`: `balanced` and
-/// `fast`; `balanced`: `fast`) and keeps the fastest valid plan, so a higher level is never worse than a
-/// lower one. The levels differ in margin and tolerances and so can end in different local optima, or, in
+/// On airborne scenes a level first runs the levels below it, cheapest first (`exact`: `fast`, then
+/// `balanced`; `balanced`: `fast`), then itself in the time left, and keeps the fastest valid plan, so a
+/// higher level is never worse than a lower one, and a time limit that cuts it leaves the plan of a cheaper
+/// level rather than the greedy run. The levels differ in margin and tolerances and so can end in different local optima, or, in
 /// a corridor little wider than the hull, with no plan that survives rounding at the tighter margin.
 pub fn solve_with_progress(
     scene: &Scene,
@@ -308,49 +309,64 @@ fn solve_within(
     budget: Budget,
 ) -> Result<Outcome> {
     let started = Instant::now();
-    let mut best = solve_once(scene, settings, budget, progress)?;
     if !scene.effects.is_air_only() {
-        return Ok(best);
+        return solve_once(scene, settings, budget, progress);
     }
-    let lower: &[Quality] = match settings.quality {
-        Quality::Fast => &[],
-        Quality::Balanced => &[Quality::Fast],
-        Quality::Exact => &[Quality::Balanced, Quality::Fast],
-    };
+    let mut runs: Vec<SearchSettings> = levels_below(settings.quality)
+        .iter()
+        .map(|&quality| SearchSettings {
+            time_limit: settings.time_limit,
+            max_frames: settings.max_frames,
+            ..SearchSettings::for_quality(quality)
+        })
+        .collect();
+    runs.push(*settings);
+    // Never empty: it ends with the requested level.
+    let first = runs.remove(0);
+    let mut best = solve_once(scene, &first, budget, progress)?;
     let mut stats = best.stats;
-    for &quality in lower {
+    for level in runs {
         if budget.expired() {
+            // The plan kept is a cheaper level's: the next one was cut before its first stage.
+            if best.status.stopped_in().is_none() {
+                best.status = SearchStatus::stopped(&budget, Stage::LowerBound);
+            }
             break;
         }
-        let other = solve_once(
-            scene,
-            &SearchSettings {
-                time_limit: settings.time_limit,
-                max_frames: settings.max_frames,
-                ..SearchSettings::for_quality(quality)
-            },
-            budget,
-            progress,
-        );
-        // A lower level cut before it had anything valid leaves the plan already found.
-        let other = match other {
-            Err(Error::Stopped { .. }) => break,
+        let other = match solve_once(scene, &level, budget, progress) {
+            // A level cut before it had anything valid leaves the plan already found.
+            Err(Error::Stopped { stage, .. }) => {
+                if best.status.stopped_in().is_none() {
+                    best.status = SearchStatus::stopped(&budget, stage);
+                }
+                break;
+            }
             other => other?,
         };
         stats.add(&other.stats);
-        if other.source == "optimised" && time_of(&other.trace) < time_of(&best.trace) {
+        // Ties go to the higher level, whose certificate had more starts.
+        if other.source == "optimised" && time_of(&other.trace) <= time_of(&best.trace) {
             best = other;
-        } else if best.status.stopped_in().is_none() {
-            // The plan kept is this level's, but the time limit (or cancel flag) cut the run after it.
-            if let Some(stage) = other.status.stopped_in() {
-                best.status = SearchStatus::stopped(&budget, stage);
-            }
+        } else if let Some(stage) = other.status.stopped_in() {
+            // The plan kept is a cheaper level's, and the time limit (or cancel flag) cut this one.
+            best.status = SearchStatus::stopped(&budget, stage);
         }
     }
     // The work of every run.
     best.stats = stats;
     best.solve_seconds = started.elapsed().as_secs_f64();
     Ok(best)
+}
+
+/// The levels an airborne solve at `quality` runs before it, cheapest first: each has a valid plan
+/// ready before the next, dearer one starts, so a time limit that cuts a higher level leaves the plan
+/// of a cheaper one rather than the greedy run.
+fn levels_below(quality: Quality) -> &'static [Quality] {
+    match quality {
+        Quality::Fast => &[],
+        Quality::Balanced => &[Quality::Fast],
+        Quality::Exact => &[Quality::Fast, Quality::Balanced],
+    }
 }
 
 /// Final wall margins tried, as multiples of the setting, until a plan stays valid.
