@@ -1,11 +1,14 @@
 //! Rounding and polish: the relaxed plan's sides rounded to `+-1` ([`super::rounding`]), then `c` polished
 //! by SCP with the sides fixed, at the final wall margin. Where rounding leaves the walls (the relaxed plan
 //! ran closer than the rounded zigzag allows), the relaxed plan is re-solved at the same frame count with a
-//! wider margin and rounded again.
+//! wider margin and rounded again. The sides are rounded at several horizons
+//! ([`super::rounding::ROUNDING_HORIZONS_S`]), each a choice of the sides' phase through the turns that
+//! the beam's tracking cost cannot rank, and every rounding is polished and verified: the search keeps the
+//! fastest.
 
 use super::model::{frame, rollout, FrameControl};
 use super::planner::Planner;
-use super::rounding::round_sides;
+use super::rounding::{round_sides, ROUNDING_HORIZONS_S};
 use super::scp::{model_crossing, ScpProblem, CLEAN_VIOLATION_UNITS};
 use crate::budget::Stage;
 
@@ -14,38 +17,51 @@ const MARGIN_RETRIES: usize = 3;
 /// Factor by which that margin grows each time.
 const MARGIN_GROWTH: f64 = 2.5;
 
-/// Exact-side plans from `relaxed` (solved at `relaxed_margin`, units), polished at `final_margin`: the
-/// plans of the first rounding with one that is clear and reaches the line, after those of each
-/// wider-margin retry that had none.
+/// An exact-side plan and how it was rounded.
+pub(super) struct RoundedPlan {
+    /// One control per frame, sides `+-1`.
+    pub(super) controls: Vec<FrameControl>,
+    /// Rounded with the first horizon of [`ROUNDING_HORIZONS_S`]: these plans alone decide whether wider
+    /// margins are tried, so the other horizons only add candidates to what would be tried without them.
+    pub(super) primary: bool,
+}
+
+/// Exact-side plans from `relaxed` (solved at `relaxed_margin`, units), polished at `final_margin`, at
+/// every rounding horizon: the plans of the first rounding whose first-horizon plans include one that is
+/// clear and reaches the line, after those of each wider-margin retry that had none.
 pub(super) fn rounded_and_polished(
     planner: &mut Planner,
     relaxed: &[FrameControl],
     relaxed_margin: f64,
     final_margin: f64,
-) -> Vec<Vec<FrameControl>> {
+) -> Vec<RoundedPlan> {
     let fl = planner.fl;
-    let mut candidates: Vec<Vec<FrameControl>> = Vec::new();
+    let mut candidates: Vec<RoundedPlan> = Vec::new();
     let mut relaxed = relaxed.to_vec();
     let mut margin = relaxed_margin;
     for attempt in 0..=MARGIN_RETRIES {
-        let Some(exact) = round_sides(&planner.start, &relaxed, &fl, &planner.budget) else {
-            planner.timed_out = true;
-            planner.note_cut(Stage::Rounding);
+        // The first horizon's plans decide whether a wider margin is needed; the others' are further
+        // candidates, the sides' phase through the turns chosen otherwise.
+        let Some(plans) = rounded_with(planner, &relaxed, ROUNDING_HORIZONS_S[0], final_margin) else {
             break;
         };
-        let plans = if planner.settings.polish_iters > 0 && !planner.timed_out {
-            polished(planner, exact, final_margin)
-        } else {
-            vec![exact]
-        };
-        let mut clear_and_reaching = false;
-        for plan in plans {
-            let st = rollout(&planner.start, &plan, &fl);
-            let clean =
-                planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS;
-            clear_and_reaching |=
-                clean && model_crossing(&planner.start, &st, planner.scene).is_some();
-            candidates.push(plan);
+        let clear_and_reaching = plans.iter().any(|plan| {
+            let st = rollout(&planner.start, plan, &fl);
+            planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS
+                && model_crossing(&planner.start, &st, planner.scene).is_some()
+        });
+        candidates.extend(plans.into_iter().map(|controls| RoundedPlan {
+            controls,
+            primary: true,
+        }));
+        for &horizon_s in &ROUNDING_HORIZONS_S[1..] {
+            let Some(plans) = rounded_with(planner, &relaxed, horizon_s, final_margin) else {
+                break;
+            };
+            candidates.extend(plans.into_iter().map(|controls| RoundedPlan {
+                controls,
+                primary: false,
+            }));
         }
         planner.note_cut(Stage::Rounding);
         if clear_and_reaching || attempt == MARGIN_RETRIES || planner.timed_out {
@@ -55,6 +71,27 @@ pub(super) fn rounded_and_polished(
         relaxed = resolved_wider(planner, relaxed, margin);
     }
     candidates
+}
+
+/// The sides of `relaxed` rounded weighing heading errors over `horizon_s` seconds, then polished at
+/// `final_margin` ([`polished`]); `None` when the budget ran out while rounding.
+fn rounded_with(
+    planner: &mut Planner,
+    relaxed: &[FrameControl],
+    horizon_s: f64,
+    final_margin: f64,
+) -> Option<Vec<Vec<FrameControl>>> {
+    let fl = planner.fl;
+    let Some(exact) = round_sides(&planner.start, relaxed, &fl, horizon_s, &planner.budget) else {
+        planner.timed_out = true;
+        planner.note_cut(Stage::Rounding);
+        return None;
+    };
+    Some(if planner.settings.polish_iters > 0 && !planner.timed_out {
+        polished(planner, exact, final_margin)
+    } else {
+        vec![exact]
+    })
 }
 
 /// `exact` with its sides fixed and `c` polished at `margin`, as two plans: first with every frame at most

@@ -6,12 +6,18 @@ use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 
 /// How far ahead a heading error is weighed by the side rounding, seconds.
 pub(super) const ROUNDING_HORIZON_S: f64 = 0.05;
+/// The horizons the sides are rounded with, seconds, each rounding polished and verified as a candidate:
+/// a shorter horizon lets the heading lag the relaxed line's for less cross-track error, a longer one the
+/// reverse, so through a turn they carry the sides' phase differently, and which phase polishes to the
+/// faster plan shows only after polishing. Not tuned: the others bracket [`ROUNDING_HORIZON_S`] by a
+/// factor of about 2.5 and 3.
+pub(super) const ROUNDING_HORIZONS_S: [f64; 3] = [ROUNDING_HORIZON_S, 0.02, 0.15];
 /// Side sequences kept by the rounding's beam search.
 const ROUNDING_BEAM: usize = 64;
 
 /// Rounds relaxed sides to `+-1`: a beam search over side sequences that keeps the exact trajectory on the
 /// relaxed one. A sequence's cost adds, each frame, the squared position error and the squared distance
-/// its heading error would drift over a short horizon. Rounding frame by frame keeps the heading error
+/// its heading error would drift over `horizon_s` seconds. Rounding frame by frame keeps the heading error
 /// bounded but not zero-mean where the relaxed sides saturate, and a steady heading error of a few
 /// hundredths of a radian drifts the path by tens of units.
 /// `None` when `budget` runs out first.
@@ -19,10 +25,10 @@ pub(super) fn round_sides(
     start: &ModelState,
     controls: &[FrameControl],
     fl: &FrameLaw,
+    horizon_s: f64,
     budget: &Budget,
 ) -> Option<Vec<FrameControl>> {
     let relaxed = rollout(start, controls, fl);
-    let horizon_s = ROUNDING_HORIZON_S;
     // Beam entries: (cost, state, index into the history of choices).
     let mut history: Vec<(usize, f64)> = Vec::with_capacity(controls.len() * ROUNDING_BEAM * 2);
     let mut beam: Vec<(f64, ModelState, usize)> = vec![(0.0, *start, usize::MAX)];
@@ -66,3 +72,4 @@ pub(super) fn round_sides(
             .collect(),
     )
 }
+

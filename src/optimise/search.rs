@@ -493,18 +493,19 @@ fn solve_once(
     );
     progress(Progress::Finishing);
     // Stages 3 and 4 for each relaxed line, first with the settings' final margin; if no plan of the line
-    // stays valid through rounding and quantisation (a tight margin along a long wall), again with wider
-    // ones.
+    // rounded at the first horizon stays valid through rounding and quantisation (a tight margin along a
+    // long wall), again with wider ones.
     let mut best: Option<(f64, Trace, Vec<FrameControl>)> = None;
     for (relaxed, margin) in &sources {
         for final_margin in FINAL_MARGIN_FACTORS.map(|f| f * settings.margin_units) {
             let mut valid = false;
             for plan in rounded_and_polished(&mut planner, relaxed, *margin, final_margin) {
-                if let Some((t, trace)) = quantised_and_verified(&mut planner, plan.clone()) {
-                    valid = true;
+                let controls = plan.controls;
+                if let Some((t, trace)) = quantised_and_verified(&mut planner, controls.clone()) {
+                    valid |= plan.primary;
                     let limit = best.as_ref().map_or(time_of(greedy), |b| b.0);
                     if t < limit {
-                        best = Some((t, trace, plan));
+                        best = Some((t, trace, controls));
                     }
                 }
             }
