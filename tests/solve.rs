@@ -277,7 +277,7 @@ fn a_start_too_fast_for_the_corner_brakes_before_it() {
 fn a_rounding_that_misses_the_relaxed_frame_at_one_horizon_is_found_at_another() {
     // Generated scene 2 of seed 43 (CI-sized family: 100 fps, air acceleration 100, 1441 ups into two
     // turns): rounded weighing heading errors over 0.05 s only, the plan crossed in frame 100 (0.9907 s),
-    // a frame behind its relaxed certificate; the sides rounded over 0.02 s or 0.15 s reach frame 99.
+    // a frame behind its relaxed certificate; the sides rounded over 0.15 s as well reach frame 99.
     let g = strafeopt::scene::generate::generate(
         43,
         2,

@@ -42,7 +42,8 @@ pub(super) fn rounded_and_polished(
     for attempt in 0..=MARGIN_RETRIES {
         // The first horizon's plans decide whether a wider margin is needed; the others' are further
         // candidates, the sides' phase through the turns chosen otherwise.
-        let Some(plans) = rounded_with(planner, &relaxed, ROUNDING_HORIZONS_S[0], final_margin) else {
+        let Some(plans) = rounded_with(planner, &relaxed, ROUNDING_HORIZONS_S[0], final_margin)
+        else {
             break;
         };
         let clear_and_reaching = plans.iter().any(|plan| {

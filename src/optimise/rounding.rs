@@ -7,11 +7,11 @@ use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 /// How far ahead a heading error is weighed by the side rounding, seconds.
 pub(super) const ROUNDING_HORIZON_S: f64 = 0.05;
 /// The horizons the sides are rounded with, seconds, each rounding polished and verified as a candidate:
-/// a shorter horizon lets the heading lag the relaxed line's for less cross-track error, a longer one the
-/// reverse, so through a turn they carry the sides' phase differently, and which phase polishes to the
-/// faster plan shows only after polishing. Not tuned: the others bracket [`ROUNDING_HORIZON_S`] by a
-/// factor of about 2.5 and 3.
-pub(super) const ROUNDING_HORIZONS_S: [f64; 3] = [ROUNDING_HORIZON_S, 0.02, 0.15];
+/// a longer horizon keeps the heading closer to the relaxed line's for more cross-track error now, so
+/// through a turn it carries the sides' phase otherwise, and which phase polishes to the faster plan shows
+/// only after polishing. A third, shorter horizon (0.02 s) was tried beside these and added almost
+/// nothing for its cost (docs/design.md, "What rounding costs").
+pub(super) const ROUNDING_HORIZONS_S: [f64; 2] = [ROUNDING_HORIZON_S, 0.15];
 /// Side sequences kept by the rounding's beam search.
 const ROUNDING_BEAM: usize = 64;
 
@@ -72,4 +72,3 @@ pub(super) fn round_sides(
             .collect(),
     )
 }
-
