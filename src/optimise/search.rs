@@ -267,9 +267,10 @@ pub fn solve(scene: &Scene, settings: &SearchSettings) -> Result<Outcome> {
 ///
 /// On airborne scenes a level first runs the levels below it, cheapest first (`exact`: `fast`, then
 /// `balanced`; `balanced`: `fast`), then itself in the time left, and keeps the fastest valid plan, so a
-/// higher level is never worse than a lower one, and a time limit that cuts it leaves the plan of a cheaper
-/// level rather than the greedy run. The levels differ in margin and tolerances and so can end in different local optima, or, in
-/// a corridor little wider than the hull, with no plan that survives rounding at the tighter margin.
+/// higher level is never worse than a lower one, and a time limit that cuts it leaves the plan of a
+/// cheaper level rather than the greedy run. The levels differ in margin and tolerances and so can end in
+/// different local optima, or, in a corridor little wider than the hull, with no plan that survives
+/// rounding at the tighter margin.
 pub fn solve_with_progress(
     scene: &Scene,
     settings: &SearchSettings,
