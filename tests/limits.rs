@@ -249,6 +249,7 @@ fn a_higher_level_cut_after_the_cheaper_one_keeps_the_cheaper_plan() {
     assert_eq!(baselines, 2);
     assert_eq!(o.source, "optimised");
     assert_eq!(o.trace.crossing, fast.trace.crossing, "fast's plan");
+    assert_eq!(o.relaxed, fast.relaxed, "fast's certificate");
     assert_eq!(
         o.status,
         SearchStatus::Cancelled {
