@@ -42,10 +42,10 @@ pub(super) fn rounded_and_polished(
     for attempt in 0..=MARGIN_RETRIES {
         // The first horizon's plans decide whether a wider margin is needed; the others' are further
         // candidates, the sides' phase through the turns chosen otherwise.
-        let Some(plans) = rounded_with(planner, &relaxed, ROUNDING_HORIZONS_S[0], final_margin)
-        else {
+        let Some(first) = rounded(planner, &relaxed, ROUNDING_HORIZONS_S[0]) else {
             break;
         };
+        let plans = polished_if_set(planner, first.clone(), final_margin);
         let clear_and_reaching = plans.iter().any(|plan| {
             let st = rollout(&planner.start, plan, &fl);
             planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS
@@ -56,9 +56,14 @@ pub(super) fn rounded_and_polished(
             primary: true,
         }));
         for &horizon_s in &ROUNDING_HORIZONS_S[1..] {
-            let Some(plans) = rounded_with(planner, &relaxed, horizon_s, final_margin) else {
+            let Some(other) = rounded(planner, &relaxed, horizon_s) else {
                 break;
             };
+            // The same sides polish to the same plans.
+            if other == first {
+                continue;
+            }
+            let plans = polished_if_set(planner, other, final_margin);
             candidates.extend(plans.into_iter().map(|controls| RoundedPlan {
                 controls,
                 primary: false,
@@ -74,25 +79,34 @@ pub(super) fn rounded_and_polished(
     candidates
 }
 
-/// The sides of `relaxed` rounded weighing heading errors over `horizon_s` seconds, then polished at
-/// `final_margin` ([`polished`]); `None` when the budget ran out while rounding.
-fn rounded_with(
+/// The sides of `relaxed` rounded weighing heading errors over `horizon_s` seconds
+/// ([`round_sides`]); `None` when the budget ran out while rounding.
+fn rounded(
     planner: &mut Planner,
     relaxed: &[FrameControl],
     horizon_s: f64,
-    final_margin: f64,
-) -> Option<Vec<Vec<FrameControl>>> {
+) -> Option<Vec<FrameControl>> {
     let fl = planner.fl;
-    let Some(exact) = round_sides(&planner.start, relaxed, &fl, horizon_s, &planner.budget) else {
+    let exact = round_sides(&planner.start, relaxed, &fl, horizon_s, &planner.budget);
+    if exact.is_none() {
         planner.timed_out = true;
         planner.note_cut(Stage::Rounding);
-        return None;
-    };
-    Some(if planner.settings.polish_iters > 0 && !planner.timed_out {
+    }
+    exact
+}
+
+/// `exact` polished at `final_margin` ([`polished`]), or as it is when the settings polish nothing or the
+/// time is up.
+fn polished_if_set(
+    planner: &mut Planner,
+    exact: Vec<FrameControl>,
+    final_margin: f64,
+) -> Vec<Vec<FrameControl>> {
+    if planner.settings.polish_iters > 0 && !planner.timed_out {
         polished(planner, exact, final_margin)
     } else {
         vec![exact]
-    })
+    }
 }
 
 /// `exact` with its sides fixed and `c` polished at `margin`, as two plans: first with every frame at most
