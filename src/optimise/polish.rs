@@ -42,32 +42,32 @@ pub(super) fn rounded_and_polished(
     for attempt in 0..=MARGIN_RETRIES {
         // The first horizon's plans decide whether a wider margin is needed; the others' are further
         // candidates, the sides' phase through the turns chosen otherwise.
-        let Some(first) = rounded(planner, &relaxed, ROUNDING_HORIZONS_S[0]) else {
-            break;
-        };
-        let plans = polished_if_set(planner, first.clone(), final_margin);
-        let clear_and_reaching = plans.iter().any(|plan| {
-            let st = rollout(&planner.start, plan, &fl);
-            planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS
-                && model_crossing(&planner.start, &st, planner.scene).is_some()
-        });
-        candidates.extend(plans.into_iter().map(|controls| RoundedPlan {
-            controls,
-            primary: true,
-        }));
-        for &horizon_s in &ROUNDING_HORIZONS_S[1..] {
-            let Some(other) = rounded(planner, &relaxed, horizon_s) else {
+        let mut clear_and_reaching = false;
+        let mut first_sides: Option<Vec<FrameControl>> = None;
+        for (i, &horizon_s) in ROUNDING_HORIZONS_S.iter().enumerate() {
+            let Some(sides) = rounded(planner, &relaxed, horizon_s) else {
                 break;
             };
             // The same sides polish to the same plans.
-            if other == first {
+            if first_sides.as_ref() == Some(&sides) {
                 continue;
             }
-            let plans = polished_if_set(planner, other, final_margin);
-            candidates.extend(plans.into_iter().map(|controls| RoundedPlan {
-                controls,
-                primary: false,
-            }));
+            let primary = i == 0;
+            if primary {
+                first_sides = Some(sides.clone());
+            }
+            let plans = polished_if_set(planner, sides, final_margin);
+            clear_and_reaching |= primary
+                && plans.iter().any(|plan| {
+                    let st = rollout(&planner.start, plan, &fl);
+                    planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS
+                        && model_crossing(&planner.start, &st, planner.scene).is_some()
+                });
+            candidates.extend(
+                plans
+                    .into_iter()
+                    .map(|controls| RoundedPlan { controls, primary }),
+            );
         }
         planner.note_cut(Stage::Rounding);
         if clear_and_reaching || attempt == MARGIN_RETRIES || planner.timed_out {
