@@ -18,8 +18,9 @@ const MAX_CONTINUED_STAGES: usize = 3;
 /// About this many knots make the coarse stage (the planning steps of a 100 fps run of four seconds).
 const COARSE_KNOTS: usize = 400;
 
-/// Times a frame count that the line cannot be reached in is grown before the search gives up.
-const MAX_GROW_TRIES: usize = 3;
+/// Times a frame count that the line cannot be reached in is grown before the search gives up
+/// ([`super::planner::Planner::max_grow_tries`]).
+pub(super) const MAX_GROW_TRIES: usize = 3;
 
 /// Which relaxed problem: the wall margin and whether `c` keeps under the anglemod guard.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -177,7 +178,7 @@ pub(super) fn count_search<'a>(
                 controls = c;
             }
             _ => {
-                if best.is_some() || grow_tries >= MAX_GROW_TRIES || planner.timed_out {
+                if best.is_some() || grow_tries >= planner.max_grow_tries || planner.timed_out {
                     break;
                 }
                 // Not reachable at this count from this start: give it more steps.
@@ -241,7 +242,9 @@ pub(super) enum StartKind {
     /// A line already planned frame by frame (the relaxed stage's, or the final plan): refined at its
     /// frame count and below; it is itself a point of the certificate's problem.
     Planned,
-    /// A greedy run: coarse to fine, as the relaxed stage.
+    /// A greedy run: coarse to fine, as the relaxed stage, but never over more frames than the run's
+    /// own: a start whose line cannot be reached in the frames its run took is far from the optimum, and
+    /// growing its count (three stages over more frames each) only spends the solve's time.
     Greedy,
 }
 
@@ -269,7 +272,12 @@ impl Certifier {
         let relaxation = Relaxation::certificate();
         let solved = match kind {
             StartKind::Planned => count_search(planner, progress, start, n, lo, relaxation, 1),
-            StartKind::Greedy => relaxed_plan(planner, progress, start, n, lo, relaxation),
+            StartKind::Greedy => {
+                let grow_tries = std::mem::replace(&mut planner.max_grow_tries, 0);
+                let plan = relaxed_plan(planner, progress, start, n, lo, relaxation);
+                planner.max_grow_tries = grow_tries;
+                plan
+            }
         }
         .and_then(|p| planner.crossing_of(&p).map(|c| (c, p)));
         let reached = match (solved, own) {
@@ -314,5 +322,51 @@ impl Certifier {
             reached: self.times.len(),
             spread: slowest - best.crossing.time,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::budget::Budget;
+    use crate::optimise::baseline::baseline;
+    use crate::optimise::bound::lower_bound;
+    use crate::optimise::search::SearchSettings;
+    use crate::optimise::Quality;
+    use crate::scene::generate::{staircase, Staircase};
+    use crate::sim::Simulation;
+
+    #[test]
+    fn a_greedy_start_of_the_certificate_is_never_solved_over_more_frames_than_its_run() {
+        // The first half of a one-corner staircase's greedy seed: the line is out of its reach.
+        let g = staircase(&Staircase {
+            corners: 1,
+            ..Staircase::default()
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+        let scene = g.scene;
+        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+        let corridor = scene.corridor().unwrap_or_else(|e| panic!("{e}"));
+        let bound = lower_bound(&scene, &corridor).unwrap_or_else(|e| panic!("{e}"));
+        let budget = Budget::unlimited();
+        let base = baseline(&sim, &scene, &bound, &budget);
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let mut planner = Planner::new(&scene, &sim, &settings, &bound, base.seed(), budget);
+        let warm = planner.warm_start(base.seed());
+        let half = warm[..warm.len() / 2].to_vec();
+        let n = half.len();
+        let mut counts = Vec::new();
+        let mut certifier = Certifier::default();
+        let mut record = |p: Progress| {
+            if let Progress::FrameCount { frames, .. } = p {
+                counts.push(frames);
+            }
+        };
+        certifier.add_start(&mut planner, &mut record, half, StartKind::Greedy, 0);
+        assert!(!counts.is_empty());
+        assert!(counts.iter().all(|&c| c <= n), "{counts:?} against {n}");
+        assert!(certifier.certificate().is_none(), "{counts:?}");
+        // The planning search itself still grows a count it cannot reach the line in.
+        assert_eq!(planner.max_grow_tries, MAX_GROW_TRIES);
     }
 }
