@@ -217,11 +217,22 @@ fn finish_direction(scene: &Scene, bound: &LowerBound) -> Vec2 {
     }
 }
 
+/// What a planner of `scene` starts from, as a solve computes it: the simulation, the lower bound and the
+/// baseline (for the tests of the stages).
+#[cfg(test)]
+pub(super) fn planning_inputs(
+    scene: &Scene,
+) -> (Simulation<'_>, LowerBound, super::baseline::Baseline) {
+    let sim = Simulation::new(scene).unwrap_or_else(|e| panic!("{e}"));
+    let corridor = scene.corridor().unwrap_or_else(|e| panic!("{e}"));
+    let bound = super::bound::lower_bound(scene, &corridor).unwrap_or_else(|e| panic!("{e}"));
+    let base = super::baseline::baseline(&sim, scene, &bound, &Budget::unlimited());
+    (sim, bound, base)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimise::baseline::baseline;
-    use crate::optimise::bound::lower_bound;
     use crate::optimise::model::rollout;
     use crate::scene::generate::{generate, GeneratorSettings};
 
@@ -230,11 +241,8 @@ mod tests {
         // Generated scene 12 of seed 11: 1472 ups into a turn, so the capped greedy runs brake first.
         let g = generate(11, 12, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
         let scene = g.scene;
-        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
-        let corridor = scene.corridor().unwrap_or_else(|e| panic!("{e}"));
-        let bound = lower_bound(&scene, &corridor).unwrap_or_else(|e| panic!("{e}"));
+        let (sim, bound, base) = planning_inputs(&scene);
         let budget = Budget::unlimited();
-        let base = baseline(&sim, &scene, &bound, &budget);
         let settings = SearchSettings::for_quality(crate::optimise::Quality::Fast);
         let mut braked = 0;
         for run in &base.clean {

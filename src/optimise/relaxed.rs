@@ -329,12 +329,10 @@ impl Certifier {
 mod tests {
     use super::*;
     use crate::budget::Budget;
-    use crate::optimise::baseline::baseline;
-    use crate::optimise::bound::lower_bound;
+    use crate::optimise::planner::planning_inputs;
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
     use crate::scene::generate::{staircase, Staircase};
-    use crate::sim::Simulation;
 
     #[test]
     fn a_greedy_start_of_the_certificate_is_never_solved_over_more_frames_than_its_run() {
@@ -345,11 +343,8 @@ mod tests {
         })
         .unwrap_or_else(|e| panic!("{e}"));
         let scene = g.scene;
-        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
-        let corridor = scene.corridor().unwrap_or_else(|e| panic!("{e}"));
-        let bound = lower_bound(&scene, &corridor).unwrap_or_else(|e| panic!("{e}"));
+        let (sim, bound, base) = planning_inputs(&scene);
         let budget = Budget::unlimited();
-        let base = baseline(&sim, &scene, &bound, &budget);
         let settings = SearchSettings::for_quality(Quality::Fast);
         let mut planner = Planner::new(&scene, &sim, &settings, &bound, base.seed(), budget);
         let warm = planner.warm_start(base.seed());
