@@ -3,10 +3,11 @@
 //! Clarabel as `min 0.5 z'Pz + q'z  s.t.  Az + s = b, s in K`.
 //!
 //! Variables, in order: per frame `k` the control change `(d sigma_k, d c_k / C_SCALE)`; per frame the
-//! state change `dx_k = (d px, d py, d V, d psi)` after frame `k`; one slack per wall row. Rows: the
-//! linearised dynamics (zero cone, one block per frame: `dx_k - A_k dx_{k-1} - B_k du_k = 0`) and the
-//! controls with no room to move (`du = 0`), then inequalities (nonnegative cone): wall rows
-//! `-n . dp_k - s_j <= n . p_k - offset - margin`, slack signs, and the trust-region and bound rows on
+//! state change `dx_k = (d px, d py, d V, d psi)` after frame `k`; one slack per group of wall rows (the
+//! rows that keep one move clear). Rows: the linearised dynamics (zero cone, one block per frame:
+//! `dx_k - A_k dx_{k-1} - B_k du_k = 0`) and the controls with no room to move (`du = 0`), then
+//! inequalities (nonnegative cone): wall rows `-n . dp_k - s_g <= n . p_k - offset - margin` (`g` the
+//! row's group), slack signs, and the trust-region and bound rows on
 //! the other controls. The objective is minus the progress of the last position, the slack's weight,
 //! and with [`SubProblem::curvature`] the convexified curvature of the Lagrangian
 //! ([`super::lagrangian`]), which makes the model right to second order.
@@ -26,13 +27,16 @@ pub const C_SCALE_UPS: f64 = 10.0;
 pub const CONTROL_REGULARISATION: f64 = 1e-6;
 
 /// A wall row: the position after frame `frame` (0-based) must stay on the free side of `plane` by
-/// `margin` units.
+/// `margin` units. Rows with the same `group` share one slack: the rows that keep one move clear, so a
+/// violation is paid once per move, as the merit counts it (each move's worst clearance).
 #[derive(Clone, Copy, Debug)]
 pub struct WallRow {
     /// 0-based frame whose end position is constrained.
     pub frame: usize,
     /// The half-plane.
     pub plane: HalfPlane,
+    /// The slack this row shares with the other rows of its group (the 0-based move it keeps clear).
+    pub group: usize,
 }
 
 /// Everything the sub-problem needs about the current trajectory.
@@ -131,7 +135,20 @@ pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
 /// [`solve`] with Clarabel's iteration cap and time limit, seconds.
 fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> SubStep {
     let n = sp.jacobians.len();
-    let m_w = sp.walls.len();
+    // One slack per group of wall rows, numbered in order of first appearance.
+    let mut slack_of_group: Vec<Option<usize>> = Vec::new();
+    let mut row_slack: Vec<usize> = Vec::with_capacity(sp.walls.len());
+    let mut m_w = 0;
+    for w in sp.walls {
+        if slack_of_group.len() <= w.group {
+            slack_of_group.resize(w.group + 1, None);
+        }
+        let slack = *slack_of_group[w.group].get_or_insert_with(|| {
+            m_w += 1;
+            m_w - 1
+        });
+        row_slack.push(slack);
+    }
     let nu = 2 * n;
     let nx = 4 * n;
     let nvar = nu + nx + m_w;
@@ -200,7 +217,7 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     for (j, w) in sp.walls.iter().enumerate() {
         let p = sp.positions[w.frame];
         ri.extend([row, row, row]);
-        ci.extend([ix(w.frame, 0), ix(w.frame, 1), is(j)]);
+        ci.extend([ix(w.frame, 0), ix(w.frame, 1), is(row_slack[j])]);
         vals.extend([-w.plane.normal.x, -w.plane.normal.y, -1.0]);
         let rhs = w.plane.side(p) - sp.margin;
         b.push(rhs);
@@ -335,17 +352,19 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     } else {
         0.0
     };
-    // The merit's violation, linearised: per wall row, how far below the accepted clearance it is before
-    // and after the step (the merit counts each frame's worst row; rows of one frame rarely differ much).
-    let mut viol_before = 0.0;
-    let mut viol_after = 0.0;
-    for w in sp.walls {
+    // The merit's violation, linearised: per group of wall rows (one move), how far its worst row is
+    // below the accepted clearance, before and after the step.
+    let mut worst_before = vec![0.0_f64; m_w];
+    let mut worst_after = vec![0.0_f64; m_w];
+    for (w, &slack) in sp.walls.iter().zip(&row_slack) {
         let p = sp.positions[w.frame];
         let side = w.plane.side(p);
         let dp = w.plane.normal.x * x[ix(w.frame, 0)] + w.plane.normal.y * x[ix(w.frame, 1)];
-        viol_before += (sp.accepted_clearance - side).max(0.0);
-        viol_after += (sp.accepted_clearance - side - dp).max(0.0);
+        worst_before[slack] = worst_before[slack].max(sp.accepted_clearance - side);
+        worst_after[slack] = worst_after[slack].max(sp.accepted_clearance - side - dp);
     }
+    let viol_before: f64 = worst_before.iter().sum();
+    let viol_after: f64 = worst_after.iter().sum();
     // The model's second-order term, 0.5 d' W d, over the curvature blocks.
     let mut curvature_term = 0.0;
     if let Some(blocks) = sp.curvature {
@@ -384,6 +403,7 @@ mod tests {
     ) -> (Vec<FrameJacobian>, Vec<Vec2>, Vec<WallRow>) {
         let walls = vec![WallRow {
             frame: 0,
+            group: 0,
             plane: HalfPlane {
                 normal: Vec2::new(0.0, -1.0),
                 offset: -rhs_side,
@@ -458,6 +478,54 @@ mod tests {
             "{:?}",
             r.status
         );
+    }
+
+    #[test]
+    fn the_rows_of_one_move_share_one_slack() {
+        // Sigma moves the end position up and along: one unit of progress per unit of violation of two
+        // walls of the same move, both out of reach. At a slack weight of 0.75 the step pays for the
+        // violation once (0.75 < 1: sigma rises); paid per row (1.5 > 1) sigma would fall.
+        let mut a = [[0.0; 4]; 4];
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] = 1.0;
+        }
+        let jac = FrameJacobian {
+            a,
+            b: [[1.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
+        };
+        let wall = |offset: f64, group: usize| WallRow {
+            frame: 0,
+            group,
+            plane: HalfPlane {
+                normal: Vec2::new(0.0, -1.0),
+                offset,
+            },
+        };
+        let ranges = [(1.0, 1.0)];
+        let (j, p) = (vec![jac], vec![Vec2::new(5.0, 0.0)]);
+        for (groups, sigma_rises) in [([0, 0], true), ([0, 1], false)] {
+            let w = [wall(50.0, groups[0]), wall(40.0, groups[1])];
+            let sp = SubProblem {
+                slack_weight: 0.75,
+                ..sub(&j, &p, &w, &ranges)
+            };
+            let r = solve(&sp);
+            assert!(matches!(r.status, SubStepStatus::Solved { .. }));
+            assert_eq!(
+                r.du[0].0 > 0.5,
+                sigma_rises,
+                "groups {groups:?}: {:?}",
+                r.du
+            );
+            // The prediction counts the move's worst row once: progress 1 less 0.75 per unit of
+            // the worst violation, or nothing gained the other way.
+            let expected = if sigma_rises {
+                1.0 - 0.75
+            } else {
+                -1.0 + 2.0 * 0.75
+            };
+            assert!((r.predicted - expected).abs() < 1e-5, "{}", r.predicted);
+        }
     }
 
     #[test]

@@ -128,11 +128,13 @@ impl ScpProblem<'_> {
                 walls.push(WallRow {
                     frame: k,
                     plane: sep.plane,
+                    group: k,
                 });
                 if k > 0 {
                     walls.push(WallRow {
                         frame: k - 1,
                         plane: sep.plane,
+                        group: k,
                     });
                 }
             }

@@ -104,6 +104,7 @@ impl SubStepSetup {
                 walls.push(WallRow {
                     frame: k,
                     plane: sep.plane,
+                    group: k,
                 });
             }
             positions.push(next.pos);
