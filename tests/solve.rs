@@ -151,6 +151,9 @@ fn solving_twice_gives_the_same_plan() {
     let b = solve(&scene, &s).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(a.controls, b.controls);
     assert_eq!(a.trace.crossing, b.trace.crossing);
+    // The certificate's greedy starts run on a thread of their own: the certificate is the same too.
+    assert_eq!(a.relaxed, b.relaxed);
+    assert!(a.relaxed.is_some_and(|r| r.starts >= 2), "{:?}", a.relaxed);
 }
 
 #[test]
@@ -287,5 +290,24 @@ fn a_rounding_that_misses_the_relaxed_frame_at_one_horizon_is_found_at_another()
     let (o, plan) = solved(&g.scene, Quality::Fast);
     let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
     assert_eq!(plan.frames, r.frames, "{plan:?} against {r:?}");
+    assert!(o.trace.feasible() && o.engine_exact.feasible());
+}
+
+#[test]
+fn a_line_refined_at_the_tight_margin_reaches_the_certificate_frame() {
+    // Generated scene 12 of seed 71 (CI-sized family: 100 fps, air acceleration 100, 270 ups into one
+    // turn of the 182-unit corridor): rounded from the line planned 3.2 units off the walls (room for a
+    // braking frame's push, `tau gamma1`), the plan crossed in frame 310, a frame behind its certificate;
+    // the line refined at the tight margin (`tau L`, twice the swing of alternating sides) reaches
+    // frame 309.
+    let g = strafeopt::scene::generate::generate(
+        71,
+        12,
+        &strafeopt::scene::generate::GeneratorSettings::ci_sized(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let (o, plan) = solved(&g.scene, Quality::Fast);
+    let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
+    assert_eq!((plan.frames, r.frames), (309, 309), "{plan:?} against {r:?}");
     assert!(o.trace.feasible() && o.engine_exact.feasible());
 }

@@ -93,6 +93,32 @@ impl<'a> Planner<'a> {
         }
     }
 
+    /// A planner for work on another thread: the same scene, start, law, settings and budget, with work
+    /// counts of its own ([`Planner::join`] adds them back).
+    pub(super) fn fork(&self) -> Planner<'a> {
+        Planner {
+            scene: self.scene,
+            sim: self.sim,
+            settings: self.settings,
+            start: self.start,
+            prefix: self.prefix.clone(),
+            fl: self.fl,
+            progress_dir: self.progress_dir,
+            budget: self.budget,
+            stats: SearchStats::default(),
+            timed_out: false,
+            cut_in: None,
+            max_grow_tries: self.max_grow_tries,
+        }
+    }
+
+    /// Adds the work of a [`Planner::fork`] done, and whether the budget cut it.
+    pub(super) fn join(&mut self, forked: &Planner) {
+        self.stats.add(&forked.stats);
+        self.timed_out |= forked.timed_out;
+        self.cut_in = self.cut_in.or(forked.cut_in);
+    }
+
     /// The SCP problem at wall `margin` (units), with relaxed or fixed sides, over planning steps of
     /// `frames_per_knot` frames.
     pub(super) fn problem(

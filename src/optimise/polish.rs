@@ -12,8 +12,8 @@ use super::rounding::{round_sides, ROUNDING_HORIZONS_S};
 use super::scp::{model_crossing, ScpProblem, CLEAN_VIOLATION_UNITS};
 use crate::budget::Stage;
 
-/// Times the relaxed plan is re-solved with a wider margin when rounding leaves the walls.
-const MARGIN_RETRIES: usize = 3;
+/// Times the planning line is re-solved with a wider margin when rounding leaves the walls.
+pub(super) const MARGIN_RETRIES: usize = 3;
 /// Factor by which that margin grows each time.
 const MARGIN_GROWTH: f64 = 2.5;
 
@@ -28,18 +28,20 @@ pub(super) struct RoundedPlan {
 
 /// Exact-side plans from `relaxed` (solved at `relaxed_margin`, units), polished at `final_margin`, at
 /// every rounding horizon: the plans of the first rounding whose first-horizon plans include one that is
-/// clear and reaches the line, after those of each wider-margin retry that had none.
+/// clear and reaches the line, after those of each wider-margin retry that had none (at most
+/// `margin_retries`).
 pub(super) fn rounded_and_polished(
     planner: &mut Planner,
     relaxed: &[FrameControl],
     relaxed_margin: f64,
     final_margin: f64,
+    margin_retries: usize,
 ) -> Vec<RoundedPlan> {
     let fl = planner.fl;
     let mut candidates: Vec<RoundedPlan> = Vec::new();
     let mut relaxed = relaxed.to_vec();
     let mut margin = relaxed_margin;
-    for attempt in 0..=MARGIN_RETRIES {
+    for attempt in 0..=margin_retries {
         // The first horizon's plans decide whether a wider margin is needed; the others' are further
         // candidates, the sides' phase through the turns chosen otherwise.
         let mut clear_and_reaching = false;
@@ -70,7 +72,7 @@ pub(super) fn rounded_and_polished(
             );
         }
         planner.note_cut(Stage::Rounding);
-        if clear_and_reaching || attempt == MARGIN_RETRIES || planner.timed_out {
+        if clear_and_reaching || attempt == margin_retries || planner.timed_out {
             break;
         }
         margin = (margin * MARGIN_GROWTH).max(final_margin * MARGIN_GROWTH);
@@ -122,8 +124,15 @@ fn polished(
 ) -> Vec<Vec<FrameControl>> {
     let iters = planner.settings.polish_iters;
     let pr = planner.problem(margin, false, 1);
+    let rounded = exact.clone();
     let exact = planner.stage(pr, exact, iters).0;
-    if planner.timed_out {
+    // A rounding inside a wall that the first stage could not move at all (every step rejected) does not
+    // move in the second either.
+    let stuck = exact == rounded && {
+        let states = rollout(&planner.start, &exact, &planner.fl);
+        planner.problem(margin, false, 1).violation(&states) > CLEAN_VIOLATION_UNITS
+    };
+    if planner.timed_out || stuck {
         return vec![exact];
     }
     let pr = ScpProblem {

@@ -301,6 +301,26 @@ impl Certifier {
         }
     }
 
+    /// Takes in the starts of `other`, solved apart (on another thread), as the starts after this one's:
+    /// their indices follow this one's, and a plan of theirs is the best only if strictly faster.
+    pub(super) fn absorb(&mut self, other: Certifier) {
+        let offset = self.tried;
+        self.tried += other.tried;
+        self.times.extend(other.times);
+        if let Some(plan) = other.best {
+            if self
+                .best
+                .as_ref()
+                .is_none_or(|b| plan.crossing.time < b.crossing.time)
+            {
+                self.best = Some(CertifiedPlan {
+                    start_index: plan.start_index + offset,
+                    ..plan
+                });
+            }
+        }
+    }
+
     /// The fastest relaxed plan so far.
     pub(super) fn best(&self) -> Option<&CertifiedPlan> {
         self.best.as_ref()
@@ -333,6 +353,47 @@ mod tests {
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
     use crate::scene::generate::{staircase, Staircase};
+
+    /// A certifier that tried `tried` starts, reached the line at `times` (frame 100 at 100 fps, as a
+    /// fraction through it), the fastest from start `best_index`.
+    fn certifier_of(tried: usize, fractions: &[f64], best_index: usize) -> Certifier {
+        let crossing = |f: f64| Crossing::new(100, f, 0.01);
+        let fastest = fractions.iter().copied().fold(f64::INFINITY, f64::min);
+        Certifier {
+            tried,
+            times: fractions.iter().map(|&f| crossing(f).time).collect(),
+            best: Some(CertifiedPlan {
+                controls: Vec::new(),
+                start_index: best_index,
+                crossing: crossing(fastest),
+            }),
+        }
+    }
+
+    #[test]
+    fn starts_solved_apart_follow_in_order_and_win_only_when_strictly_faster() {
+        let mut mine = certifier_of(1, &[0.5], 0);
+        // A tie does not replace the plan already held.
+        mine.absorb(certifier_of(2, &[0.7, 0.5], 1));
+        assert_eq!(mine.best().map(|b| b.start_index), Some(0));
+        // A faster plan does, numbered after every start before it.
+        mine.absorb(certifier_of(1, &[0.25], 0));
+        assert_eq!(mine.best().map(|b| b.start_index), Some(3));
+        let c = mine
+            .certificate()
+            .unwrap_or_else(|| panic!("no certificate"));
+        assert_eq!((c.starts, c.reached), (4, 4));
+        assert!((c.spread - 0.0045).abs() < 1e-12, "{c:?}");
+        // A certifier whose starts reached nothing adds its starts only.
+        mine.absorb(Certifier {
+            tried: 2,
+            ..Certifier::default()
+        });
+        let c = mine
+            .certificate()
+            .unwrap_or_else(|| panic!("no certificate"));
+        assert_eq!((c.starts, c.reached), (6, 4));
+    }
 
     #[test]
     fn a_greedy_start_of_the_certificate_is_never_solved_over_more_frames_than_its_run() {

@@ -13,15 +13,12 @@
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
+use super::airborne::plan_airborne;
 use super::baseline::{baseline, corner_caps, GreedyGuide, GuideRun};
 use super::bound::{frame_limited_scene, lower_bound_within};
-use super::model::FrameControl;
 use super::planner::Planner;
-use super::polish::rounded_and_polished;
-use super::relaxed::{
-    count_search, relaxed_plan, Certifier, Relaxation, RelaxedCertificate, StartKind,
-};
-use super::verify::{time_of, PlanPlayer};
+use super::relaxed::RelaxedCertificate;
+use super::verify::time_of;
 use super::LowerBound;
 use crate::budget::{Budget, Stage, Stop};
 use crate::error::{Error, Result};
@@ -370,9 +367,6 @@ fn levels_below(quality: Quality) -> &'static [Quality] {
     }
 }
 
-/// Final wall margins tried, as multiples of the setting, until a plan stays valid.
-const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
-
 /// What every outcome of one solve shares: the simulation, the baseline, the bound, the start time.
 struct Finisher<'a> {
     sim: &'a Simulation<'a>,
@@ -461,10 +455,6 @@ fn solve_once(
         return Ok(plan_jumping_scene(&finisher, settings, budget));
     }
     let mut planner = Planner::new(scene, &sim, settings, &bound, seed, budget);
-    // Stage 2: the relaxed problem; its margin leaves room for the zigzag of rounded sides.
-    let fl = planner.fl;
-    let zigzag = fl.tau_s * fl.law.l.max(fl.law.gamma1);
-    let relaxed_margin = settings.margin_units + zigzag;
     let warm = planner.warm_start(seed);
     let prefix_len = planner.prefix.len();
     let n = seed.crossing.map_or(warm.len(), |c| {
@@ -472,137 +462,38 @@ fn solve_once(
     });
     // No plan crosses before the bound's frame.
     let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
-    let relaxation = Relaxation::planning(relaxed_margin);
-    let Some(relaxed) = relaxed_plan(&mut planner, progress, warm, n, lo, relaxation) else {
-        let status = match planner.cut_in {
-            Some(stage) => SearchStatus::stopped(&budget, stage),
-            None => SearchStatus::NoImprovement {
-                reason: "the relaxed search found no valid plan".into(),
-            },
-        };
-        return Ok(finisher.greedy_outcome(status, planner.stats));
-    };
-    let mut certifier = Certifier::default();
-    let sources = certified_sources(
-        &mut planner,
-        &mut certifier,
-        &base,
-        relaxed,
-        relaxed_margin,
-        lo,
-        progress,
-    );
-    progress(Progress::Finishing);
-    // Stages 3 and 4 for each relaxed line, first with the settings' final margin; if no plan of the line
-    // rounded at the first horizon stays valid through rounding and quantisation (a tight margin along a
-    // long wall), again with wider ones.
-    let mut best: Option<(f64, Trace, Vec<FrameControl>)> = None;
-    for (relaxed, margin) in &sources {
-        for final_margin in FINAL_MARGIN_FACTORS.map(|f| f * settings.margin_units) {
-            let mut valid = false;
-            for plan in rounded_and_polished(&mut planner, relaxed, *margin, final_margin) {
-                let controls = plan.controls;
-                if let Some((t, trace)) = quantised_and_verified(&mut planner, controls.clone()) {
-                    valid |= plan.primary;
-                    let limit = best.as_ref().map_or(time_of(greedy), |b| b.0);
-                    if t < limit {
-                        best = Some((t, trace, controls));
-                    }
-                }
-            }
-            if valid || planner.timed_out {
-                break;
-            }
-        }
-    }
-    // The final plan is a point of the certificate's problem too: where it is faster than the certificate
-    // (the relaxed stage stopped short of its optimum), it is the last start, so that the certificate is
-    // never behind the plan.
-    let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
-    if let Some((_, _, plan)) = best.as_ref().filter(|b| behind(b.0)) {
-        certifier.add_start(&mut planner, progress, plan.clone(), StartKind::Planned, lo);
-    }
+    // Stages 2 to 4.
+    let found = plan_airborne(&mut planner, &base, warm, n, lo, time_of(greedy), progress);
     let stats = planner.stats;
     let stopped = planner
         .cut_in
         .filter(|_| planner.timed_out)
         .map(|stage| SearchStatus::stopped(&budget, stage));
-    let outcome = match best {
+    let outcome = match found.best {
         Some((t, trace, _)) => {
             let status = stopped.unwrap_or(SearchStatus::Converged {
                 gap: finisher.gap(t),
             });
             finisher.outcome(trace.controls.clone(), trace, status, stats, "optimised")
         }
-        None => finisher.greedy_outcome(
-            stopped.unwrap_or_else(|| SearchStatus::NoImprovement {
-                reason: "no optimised plan stayed valid after rounding and quantisation".into(),
-            }),
-            stats,
-        ),
+        None => {
+            let reason = if found.relaxed_found {
+                "no optimised plan stayed valid after rounding and quantisation"
+            } else {
+                "the relaxed search found no valid plan"
+            };
+            finisher.greedy_outcome(
+                stopped.unwrap_or_else(|| SearchStatus::NoImprovement {
+                    reason: reason.into(),
+                }),
+                stats,
+            )
+        }
     };
     Ok(Outcome {
-        relaxed: certifier.certificate(),
+        relaxed: found.certifier.certificate(),
         ..outcome
     })
-}
-
-/// The certificate (the relaxed optimum at the certificate's margin, from the relaxed plan and the other
-/// clean greedy runs; not from a start at rest, whose first frame is the seed's own), and the relaxed
-/// lines to round: the relaxed plan, and the line of another start where it was faster.
-fn certified_sources(
-    planner: &mut Planner,
-    certifier: &mut Certifier,
-    base: &super::baseline::Baseline,
-    relaxed: Vec<FrameControl>,
-    relaxed_margin: f64,
-    lo: usize,
-    progress: &mut dyn FnMut(Progress),
-) -> Vec<(Vec<FrameControl>, f64)> {
-    let others = if planner.prefix.is_empty() {
-        &base.clean[1.min(base.clean.len())..]
-    } else {
-        &[]
-    };
-    certifier.add_start(planner, progress, relaxed.clone(), StartKind::Planned, lo);
-    let more = planner.settings.certificate_starts.saturating_sub(1);
-    for run in others.iter().take(more) {
-        let warm = planner.warm_start(&run.trace);
-        certifier.add_start(planner, progress, warm, StartKind::Greedy, lo);
-    }
-    let mut sources = vec![(relaxed, relaxed_margin)];
-    if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
-        let (controls, n) = (plan.controls.clone(), plan.controls.len());
-        let relaxation = Relaxation::planning(relaxed_margin);
-        if let Some(r) = count_search(planner, progress, controls, n, lo, relaxation, 1) {
-            sources.push((r, relaxed_margin));
-        }
-    }
-    sources
-}
-
-/// Stage 4: `plan` played through the real frame with quantised yaws; its crossing time and trace when it
-/// is valid in f64 and in the engine-exact mode.
-fn quantised_and_verified(planner: &mut Planner, plan: Vec<FrameControl>) -> Option<(f64, Trace)> {
-    let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan, planner.fl, true);
-    let trace = planner.sim.run_within(&mut player, &planner.budget);
-    if trace.interrupted {
-        planner.timed_out = true;
-        planner.note_cut(Stage::Verification);
-        return None;
-    }
-    let t = time_of(&trace);
-    if !t.is_finite() {
-        return None;
-    }
-    let run = planner
-        .sim
-        .run_engine_exact_within(&trace.controls, &planner.budget);
-    if run.interrupted {
-        planner.timed_out = true;
-        planner.note_cut(Stage::Verification);
-    }
-    run.feasible().then_some((t, trace))
 }
 
 /// Scenes with ground frames, gravity or jumps: greedy when it already crosses in the bound's frame
@@ -668,3 +559,4 @@ mod tests {
         assert_eq!(time_limit(2.5).ok(), Some(Duration::from_millis(2500)));
     }
 }
+

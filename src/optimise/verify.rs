@@ -2,7 +2,9 @@
 //! (docs/physics.md section 1), then checked in f64 and in the engine-exact mode.
 
 use super::model::{control_for, rollout, FrameControl, FrameLaw, ModelState};
+use super::planner::Planner;
 use super::rounding::ROUNDING_HORIZON_S;
+use crate::budget::Stage;
 use crate::physics::engine_exact::{anglemod_bracket, quantise_yaw_rad};
 use crate::physics::{Control, PlayerState};
 use crate::sim::{Controller, Simulation, Trace};
@@ -83,4 +85,31 @@ pub(super) fn time_of(t: &Trace) -> f64 {
         (true, Some(c)) => c.time,
         _ => f64::INFINITY,
     }
+}
+
+/// Stage 4: `plan` played through the real frame with quantised yaws; its crossing time and trace when it
+/// is valid in f64 and in the engine-exact mode.
+pub(super) fn quantised_and_verified(
+    planner: &mut Planner,
+    plan: Vec<FrameControl>,
+) -> Option<(f64, Trace)> {
+    let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan, planner.fl, true);
+    let trace = planner.sim.run_within(&mut player, &planner.budget);
+    if trace.interrupted {
+        planner.timed_out = true;
+        planner.note_cut(Stage::Verification);
+        return None;
+    }
+    let t = time_of(&trace);
+    if !t.is_finite() {
+        return None;
+    }
+    let run = planner
+        .sim
+        .run_engine_exact_within(&trace.controls, &planner.budget);
+    if run.interrupted {
+        planner.timed_out = true;
+        planner.note_cut(Stage::Verification);
+    }
+    run.feasible().then_some((t, trace))
 }

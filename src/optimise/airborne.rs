@@ -1,0 +1,245 @@
+//! The airborne solve, stages 2 to 4 of [`super::search`] in order:
+//!
+//! 1. the relaxed line ([`super::relaxed`]) at the planning margin, which leaves room for the zigzag of
+//!    rounded sides; the count search over it is the search's globalisation;
+//! 2. the certificate: the relaxed optimum from that line and from the other clean greedy runs, the
+//!    greedy starts on a second thread, beside everything else (they need nothing of the relaxed line);
+//! 3. the same line refined at the tight margin, where the zigzag of real sides is counted at what it is
+//!    rather than at the most a braking frame could swing;
+//! 4. each line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
+//!    fastest valid exact plan is kept.
+
+use super::baseline::Baseline;
+use super::model::FrameControl;
+use super::planner::Planner;
+use super::polish::{rounded_and_polished, MARGIN_RETRIES};
+use super::relaxed::{count_search, relaxed_plan, Certifier, Relaxation, StartKind};
+use super::search::Progress;
+use super::verify::quantised_and_verified;
+use crate::sim::Trace;
+
+/// Final wall margins tried, as multiples of the setting, until a plan stays valid.
+const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
+
+/// The tight line is solved only where its margin is at most this share of the planning margin: closer
+/// to it the two lines are one (at 100 fps with air acceleration 10, `L = 30` and `gamma1 = 32`: the
+/// margins differ by 6%).
+const TIGHT_MARGIN_MAX_SHARE: f64 = 0.9;
+
+/// The wall margins of the relaxed lines, units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct LineMargins {
+    /// The planning margin: the final margin and `tau max(L, gamma1)`, the largest sideways push a frame
+    /// can give (a braking frame's, `gamma1`), so that any rounding of the sides stays clear.
+    pub(super) planning: f64,
+    /// The tight margin: the final margin and `tau min(L, gamma1)`, twice the swing of alternating sides
+    /// at full acceleration (`mu = min(L, gamma1)`, docs/physics.md section 6, moves the path
+    /// `tau mu / 2` either side of the relaxed one); `None` where it is no tighter than the planning one.
+    pub(super) tight: Option<f64>,
+}
+
+impl LineMargins {
+    /// The margins of `planner`'s frame law.
+    pub(super) fn of(planner: &Planner) -> Self {
+        let fl = planner.fl;
+        let final_margin = planner.settings.margin_units;
+        let planning = final_margin + fl.tau_s * fl.law.l.max(fl.law.gamma1);
+        let tight = final_margin + fl.tau_s * fl.law.l.min(fl.law.gamma1);
+        LineMargins {
+            planning,
+            tight: (tight <= TIGHT_MARGIN_MAX_SHARE * planning).then_some(tight),
+        }
+    }
+}
+
+/// A relaxed line to round, and the margin it was solved at.
+struct Source {
+    line: Vec<FrameControl>,
+    margin: f64,
+    /// Whether the line is the planning margin's: where none of its plans stays valid, it is re-solved
+    /// wider and the final margin widened. The tight line's plans only add candidates: at a wider margin
+    /// it would be the planning line again.
+    planning: bool,
+}
+
+/// The fastest valid exact plan so far: its crossing time (seconds), its f64 trace and its controls.
+pub(super) type BestPlan = Option<(f64, Trace, Vec<FrameControl>)>;
+
+/// What the airborne stages found.
+pub(super) struct AirbornePlan {
+    /// The fastest valid exact plan faster than greedy.
+    pub(super) best: BestPlan,
+    /// The certificate.
+    pub(super) certifier: Certifier,
+    /// Whether the relaxed stage found a line at all.
+    pub(super) relaxed_found: bool,
+}
+
+/// Stages 2 to 4 (see the module documentation): `warm` is the seed in planning controls, crossing near
+/// frame `n`; no plan crosses before frame `lo`; a plan is kept only if it is faster than `greedy_s`.
+pub(super) fn plan_airborne(
+    planner: &mut Planner,
+    base: &Baseline,
+    warm: Vec<FrameControl>,
+    n: usize,
+    lo: usize,
+    greedy_s: f64,
+    progress: &mut dyn FnMut(Progress),
+) -> AirbornePlan {
+    let margins = LineMargins::of(planner);
+    let greedy_starts = certificate_greedy_starts(planner, base);
+    let forked = planner.fork();
+    let (mine, side) = std::thread::scope(|scope| {
+        let side = scope.spawn(move || certified_greedy_starts(forked, greedy_starts, lo));
+        let mine = lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress);
+        (mine, side.join())
+    });
+    let (side_certifier, forked) = side.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+    planner.join(&forked);
+    // Without a relaxed line there is no plan for a certificate to be beside.
+    let Some((mut certifier, mut best)) = mine else {
+        return AirbornePlan {
+            best: None,
+            certifier: Certifier::default(),
+            relaxed_found: false,
+        };
+    };
+    certifier.absorb(side_certifier);
+    // A greedy start whose relaxed line is faster than the relaxed plan's: its line, refined at the
+    // planning margin, is rounded too.
+    if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
+        let (controls, n) = (plan.controls.clone(), plan.controls.len());
+        let relaxation = Relaxation::planning(margins.planning);
+        if let Some(line) = count_search(planner, progress, controls, n, lo, relaxation, 1) {
+            let source = Source {
+                line,
+                margin: margins.planning,
+                planning: true,
+            };
+            exact_plans(planner, &source, greedy_s, &mut best);
+        }
+    }
+    // The final plan is a point of the certificate's problem too: where it is faster than the certificate
+    // (the relaxed stage stopped short of its optimum), it is the last start, so that the certificate is
+    // never behind the plan.
+    let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
+    if let Some((_, _, plan)) = best.as_ref().filter(|b| behind(b.0)) {
+        certifier.add_start(planner, progress, plan.clone(), StartKind::Planned, lo);
+    }
+    AirbornePlan {
+        best,
+        certifier,
+        relaxed_found: true,
+    }
+}
+
+/// The warm starts of the certificate's greedy starts: the other clean greedy runs (not from a start at
+/// rest, whose first frame is the seed's own), as many as the settings give the certificate besides the
+/// relaxed plan.
+fn certificate_greedy_starts(planner: &Planner, base: &Baseline) -> Vec<Vec<FrameControl>> {
+    if !planner.prefix.is_empty() {
+        return Vec::new();
+    }
+    let more = planner.settings.certificate_starts.saturating_sub(1);
+    base.clean
+        .iter()
+        .skip(1)
+        .take(more)
+        .map(|run| planner.warm_start(&run.trace))
+        .collect()
+}
+
+/// The certificate's greedy starts, solved by `planner` (a fork, on its own thread), and the planner
+/// with its work counts.
+fn certified_greedy_starts<'a>(
+    mut planner: Planner<'a>,
+    starts: Vec<Vec<FrameControl>>,
+    lo: usize,
+) -> (Certifier, Planner<'a>) {
+    let mut certifier = Certifier::default();
+    for warm in starts {
+        certifier.add_start(&mut planner, &mut |_| {}, warm, StartKind::Greedy, lo);
+    }
+    (certifier, planner)
+}
+
+/// The relaxed line, the certificate's start from it, the tight line, and the exact plans of both lines;
+/// `None` when the relaxed stage found no line.
+fn lines_and_plans(
+    planner: &mut Planner,
+    warm: Vec<FrameControl>,
+    n: usize,
+    lo: usize,
+    margins: LineMargins,
+    greedy_s: f64,
+    progress: &mut dyn FnMut(Progress),
+) -> Option<(Certifier, BestPlan)> {
+    let relaxed = relaxed_plan(
+        planner,
+        progress,
+        warm,
+        n,
+        lo,
+        Relaxation::planning(margins.planning),
+    )?;
+    let mut certifier = Certifier::default();
+    certifier.add_start(planner, progress, relaxed.clone(), StartKind::Planned, lo);
+    let mut sources = vec![Source {
+        line: relaxed.clone(),
+        margin: margins.planning,
+        planning: true,
+    }];
+    if let Some(tight) = margins.tight {
+        let n = relaxed.len();
+        let relaxation = Relaxation::planning(tight);
+        if let Some(line) = count_search(planner, progress, relaxed, n, lo, relaxation, 1) {
+            sources.push(Source {
+                line,
+                margin: tight,
+                planning: false,
+            });
+        }
+    }
+    progress(Progress::Finishing);
+    let mut best = None;
+    for source in &sources {
+        exact_plans(planner, source, greedy_s, &mut best);
+    }
+    Some((certifier, best))
+}
+
+/// Stages 3 and 4 for one relaxed line: rounded, polished, quantised and verified, first at the settings'
+/// final margin; for the planning line, if no plan rounded at the first horizon stays valid (a tight
+/// margin along a long wall), again at wider ones. A plan replaces `best` when it is faster (and faster
+/// than `greedy_s`).
+fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut BestPlan) {
+    let final_margin_units = planner.settings.margin_units;
+    let (factors, margin_retries) = if source.planning {
+        (&FINAL_MARGIN_FACTORS[..], MARGIN_RETRIES)
+    } else {
+        (&FINAL_MARGIN_FACTORS[..1], 0)
+    };
+    for final_margin in factors.iter().map(|f| f * final_margin_units) {
+        let mut valid = false;
+        let plans = rounded_and_polished(
+            planner,
+            &source.line,
+            source.margin,
+            final_margin,
+            margin_retries,
+        );
+        for plan in plans {
+            let controls = plan.controls;
+            if let Some((t, trace)) = quantised_and_verified(planner, controls.clone()) {
+                valid |= plan.primary;
+                let limit = best.as_ref().map_or(greedy_s, |b| b.0);
+                if t < limit {
+                    *best = Some((t, trace, controls));
+                }
+            }
+        }
+        if valid || planner.timed_out {
+            break;
+        }
+    }
+}
