@@ -66,6 +66,7 @@ fn json_carries_every_documented_key() {
         "centre_line",
         "lookahead_units",
         "speed_cap_ups",
+        "corner_bend_units",
     ] {
         assert!(
             v["greedy"]["guide"].get(k).is_some(),

@@ -308,6 +308,10 @@ fn a_line_refined_at_the_tight_margin_reaches_the_certificate_frame() {
     .unwrap_or_else(|e| panic!("{e}"));
     let (o, plan) = solved(&g.scene, Quality::Fast);
     let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
-    assert_eq!((plan.frames, r.frames), (309, 309), "{plan:?} against {r:?}");
+    assert_eq!(
+        (plan.frames, r.frames),
+        (309, 309),
+        "{plan:?} against {r:?}"
+    );
     assert!(o.trace.feasible() && o.engine_exact.feasible());
 }

@@ -16,10 +16,10 @@ use super::LowerBound;
 use crate::budget::Budget;
 use crate::geometry::{Corridor, HULL_HALF_WIDTH_UNITS};
 use crate::physics::closed_form::max_groundstrafe_speed;
-use crate::physics::curvature::{bend_arc_radius, speed_for_radius, turn_arc_radius};
+use crate::physics::curvature::{air_law, bend_arc_radius, speed_for_radius, turn_arc_radius};
 use crate::physics::{Effect, Vec2};
 use crate::scene::Scene;
-use crate::sim::controllers::{Greedy, GREEDY_LOOKAHEADS_UNITS};
+use crate::sim::controllers::{CornerSpeed, CornerSpeeds, Greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{Simulation, Trace};
 
 /// Extra clearances of the guide paths off the walls, units (beyond the hull's half width).
@@ -52,6 +52,9 @@ pub struct GreedyGuide {
     pub lookahead_units: f64,
     /// The speed the strafer holds once reached, ups, if capped.
     pub speed_cap_ups: Option<f64>,
+    /// The width of the bends, units for the hull centre, whose arcs' speeds the strafer keeps under
+    /// through each corner of its guide (and brakes for before it), if it does.
+    pub corner_bend_units: Option<f64>,
 }
 
 impl std::fmt::Display for GreedyGuide {
@@ -72,6 +75,9 @@ impl std::fmt::Display for GreedyGuide {
         write!(f, ", look-ahead {:.1} units", self.lookahead_units)?;
         if let Some(cap) = self.speed_cap_ups {
             write!(f, ", speed cap {cap:.1} ups")?;
+        }
+        if let Some(w) = self.corner_bend_units {
+            write!(f, ", corner speeds of {w:.0}-unit bends")?;
         }
         Ok(())
     }
@@ -130,19 +136,76 @@ pub(super) fn corner_caps(scene: &Scene, path: &[Vec2]) -> Vec<f64> {
 /// several points is wrapped by several vertices).
 const CORNER_SPAN_UNITS: f64 = 64.0;
 
-/// The largest turn of the polyline `path` at one corner, radians: the turns of consecutive vertices
-/// that bend the same way within [`CORNER_SPAN_UNITS`] of each other, summed.
-fn sharpest_corner_rad(path: &[Vec2]) -> f64 {
-    let mut sharpest: f64 = 0.0;
-    let mut current = 0.0;
+/// A corner of a guide path: the vertices that bend the same way within [`CORNER_SPAN_UNITS`] of each
+/// other.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PathCorner {
+    /// Arc length of its first vertex along the path, units.
+    first_units: f64,
+    /// Arc length of its last vertex, units.
+    last_units: f64,
+    /// Its turn, radians (positive: left).
+    turn_rad: f64,
+}
+
+/// The corners of the polyline `path`, in order.
+fn path_corners(path: &[Vec2]) -> Vec<PathCorner> {
+    let mut corners: Vec<PathCorner> = Vec::new();
+    let mut s = 0.0;
     for w in path.windows(3) {
         let (a, b) = (w[1] - w[0], w[2] - w[1]);
+        s += a.length();
         let turn = a.cross(b).atan2(a.dot(b));
-        let joined = current * turn > 0.0 && a.length() < CORNER_SPAN_UNITS;
-        current = if joined { current + turn } else { turn };
-        sharpest = sharpest.max(current.abs());
+        match corners.last_mut() {
+            Some(c) if c.turn_rad * turn > 0.0 && a.length() < CORNER_SPAN_UNITS => {
+                c.turn_rad += turn;
+                c.last_units = s;
+            }
+            _ => corners.push(PathCorner {
+                first_units: s,
+                last_units: s,
+                turn_rad: turn,
+            }),
+        }
     }
-    sharpest
+    // A vertex on a straight line (no turn) is no corner.
+    corners.retain(|c| c.turn_rad.abs() > 1e-12);
+    corners
+}
+
+/// The largest turn of the polyline `path` at one corner, radians (see [`path_corners`]).
+fn sharpest_corner_rad(path: &[Vec2]) -> f64 {
+    path_corners(path)
+        .iter()
+        .map(|c| c.turn_rad.abs())
+        .fold(0.0, f64::max)
+}
+
+/// The speeds an airborne strafer along `path` keeps under for bends `width_units` wide (for the hull
+/// centre): through each corner, the speed whose measured radius (docs/physics.md section 9) is the
+/// largest arc through a bend of that width and the corner's turn, over that arc (its tangent length
+/// `r tan(turn / 2)`, at most `r`, either side of the corner), and before it what braking at `gamma1` a
+/// frame (section 7) can bring down to it. A corner whose arc needs more than `sv_maxvelocity` does not
+/// limit.
+fn corner_speeds(scene: &Scene, path: &[Vec2], width_units: f64) -> CornerSpeeds {
+    let corners = path_corners(path)
+        .iter()
+        .filter_map(|c| {
+            let turn = c.turn_rad.abs();
+            let r = turn_arc_radius(width_units, turn);
+            let speed_ups = speed_for_radius(&scene.vars, r).ok()?;
+            let half = r * (0.5 * turn).tan().min(1.0);
+            Some(CornerSpeed {
+                start_units: c.first_units - half,
+                end_units: c.last_units + half,
+                speed_ups,
+            })
+        })
+        .collect();
+    CornerSpeeds {
+        corners,
+        braking_ups_per_s: air_law(&scene.vars).gamma1 / scene.frame_time_s(),
+    }
 }
 
 /// Shares of the groundstrafing top speed (docs/physics.md section 12) the ground's capped greedy runs
@@ -166,23 +229,45 @@ struct GuidePath {
     clearance_units: f64,
     centre_line: bool,
     path: Vec<Vec2>,
+    /// On airborne scenes, the corner speeds along it for each of [`CAP_WIDTHS_UNITS`] ([`corner_speeds`]).
+    corner_speeds: Vec<(f64, CornerSpeeds)>,
+}
+
+impl GuidePath {
+    /// The guide along `path`, with its corner speeds on airborne scenes.
+    fn new(scene: &Scene, clearance_units: f64, centre_line: bool, path: Vec<Vec2>) -> Self {
+        let corner_speeds = if scene.effects.is_air_only() {
+            CAP_WIDTHS_UNITS
+                .iter()
+                .map(|&w| (w, corner_speeds(scene, &path, w)))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        GuidePath {
+            clearance_units,
+            centre_line,
+            path,
+            corner_speeds,
+        }
+    }
+}
+
+/// How a greedy run keeps its speed down: a speed cap held once reached, or the corner speeds of bends of
+/// a width (units, for the hull centre).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum SpeedLimit {
+    Cap(f64),
+    CornerSpeeds(f64),
 }
 
 /// The guide paths of `scene`: the shortest path (the lower bound's) and the paths kept each of
 /// [`GUIDE_CLEARANCES_UNITS`] off the walls where the corridor has room, then the centre line.
 fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
-    let mut guides = vec![GuidePath {
-        clearance_units: 0.0,
-        centre_line: false,
-        path: bound.path.clone(),
-    }];
+    let mut guides = vec![GuidePath::new(scene, 0.0, false, bound.path.clone())];
     for &extra in &GUIDE_CLEARANCES_UNITS[1..] {
         match clear_path(scene, extra) {
-            Some(path) => guides.push(GuidePath {
-                clearance_units: extra,
-                centre_line: false,
-                path,
-            }),
+            Some(path) => guides.push(GuidePath::new(scene, extra, false, path)),
             None => break,
         }
     }
@@ -191,11 +276,7 @@ fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
             .iter()
             .any(|g| (g.clearance_units - extra).abs() < 2.0 * CENTRE_LINE_TOL_UNITS);
         if !known {
-            guides.push(GuidePath {
-                clearance_units: extra,
-                centre_line: true,
-                path,
-            });
+            guides.push(GuidePath::new(scene, extra, true, path));
         }
     }
     guides
@@ -244,8 +325,14 @@ pub(super) fn baseline(
     // in both arithmetics: maximum acceleration overshoots a sharp corner of a narrow corridor, and along
     // a solid wall it scrapes where the game's f32 replay parts ways.
     let on_ground = !fx.is_air_only();
-    let caps = if fx.is_air_only() {
-        corner_caps(scene, &bound.path)
+    let limits: Vec<SpeedLimit> = if fx.is_air_only() {
+        let caps = corner_caps(scene, &bound.path)
+            .into_iter()
+            .map(SpeedLimit::Cap);
+        let corners = CAP_WIDTHS_UNITS
+            .iter()
+            .map(|&w| SpeedLimit::CornerSpeeds(w));
+        caps.chain(corners).collect()
     } else {
         Vec::new()
     };
@@ -255,7 +342,7 @@ pub(super) fn baseline(
     sweep_guides(
         sim,
         &guides,
-        &caps,
+        &limits,
         true,
         broken_frame_limit,
         budget,
@@ -264,10 +351,14 @@ pub(super) fn baseline(
     let mut greedy = pick_greedy(sim, &guides, &runs, &[], budget);
     if on_ground && !greedy.engine_valid && !budget.expired() {
         let checked = runs.valid.clone();
+        let caps: Vec<SpeedLimit> = ground_caps(scene, &bound.path)
+            .into_iter()
+            .map(SpeedLimit::Cap)
+            .collect();
         sweep_guides(
             sim,
             &guides,
-            &ground_caps(scene, &bound.path),
+            &caps,
             false,
             broken_frame_limit,
             budget,
@@ -300,41 +391,55 @@ struct GuideRuns {
     clean: Vec<(f64, usize, GreedyGuide)>,
 }
 
-/// The greedy strafer along guide `path` with `guide`'s look-ahead and cap.
-fn strafer(path: &[Vec2], guide: &GreedyGuide) -> Greedy {
-    let g = Greedy::new(path.to_vec(), guide.lookahead_units);
-    match guide.speed_cap_ups {
-        Some(cap) => g.with_speed_cap(cap),
-        None => g,
+/// The greedy strafer along guide `path` with `guide`'s look-ahead, cap and corner speeds.
+fn strafer(path: &GuidePath, guide: &GreedyGuide) -> Greedy {
+    let mut g = Greedy::new(path.path.clone(), guide.lookahead_units);
+    if let Some(cap) = guide.speed_cap_ups {
+        g = g.with_speed_cap(cap);
     }
+    // The width is one of CAP_WIDTHS_UNITS copied into the guide: equal bit for bit.
+    let corners = guide.corner_bend_units.and_then(|w| {
+        path.corner_speeds
+            .iter()
+            .find(|(width, _)| width.to_bits() == w.to_bits())
+    });
+    if let Some((_, speeds)) = corners {
+        g = g.with_corner_speeds(speeds.clone());
+    }
+    g
 }
 
 /// Run `i`'s guide played again whole.
 fn replay(sim: &Simulation, guides: &[GuidePath], i: usize, guide: GreedyGuide) -> GuideRun {
     GuideRun {
         guide,
-        trace: sim.run(&mut strafer(&guides[i].path, &guide)),
+        trace: sim.run(&mut strafer(&guides[i], &guide)),
     }
 }
 
-/// Plays every guide at every look-ahead, with no cap first when `uncapped`, then each of `caps`, for
+/// Plays every guide at every look-ahead, with no limit first when `uncapped`, then each of `limits`, for
 /// their verdicts only, into `runs` (kept sorted fastest first).
 fn sweep_guides(
     sim: &Simulation,
     guides: &[GuidePath],
-    caps: &[f64],
+    limits: &[SpeedLimit],
     uncapped: bool,
     broken_frame_limit: u64,
     budget: &Budget,
     runs: &mut GuideRuns,
 ) {
     let first = uncapped.then_some(None);
-    'sweep: for cap in first.into_iter().chain(caps.iter().copied().map(Some)) {
-        // Capped runs along the shortest path and the widest guide only: the caps are for corners the
+    'sweep: for limit in first.into_iter().chain(limits.iter().copied().map(Some)) {
+        let (cap, corner_bend_units) = match limit {
+            None => (None, None),
+            Some(SpeedLimit::Cap(cap)) => (Some(cap), None),
+            Some(SpeedLimit::CornerSpeeds(w)) => (None, Some(w)),
+        };
+        // Limited runs along the shortest path and the widest guide only: the limits are for corners the
         // uncapped strafer overshoots, and every guide in between would multiply the runs.
         let last = guides.len() - 1;
         for (i, g) in guides.iter().enumerate() {
-            if cap.is_some() && i != 0 && i != last {
+            if limit.is_some() && i != 0 && i != last {
                 continue;
             }
             let mut best_clean: Option<(f64, usize, GreedyGuide)> = None;
@@ -350,9 +455,10 @@ fn sweep_guides(
                     centre_line: g.centre_line,
                     lookahead_units: la,
                     speed_cap_ups: cap,
+                    corner_bend_units,
                 };
                 let run = sim.run_summary_broken_until(
-                    &mut strafer(&g.path, &guide),
+                    &mut strafer(g, &guide),
                     budget,
                     broken_frame_limit,
                 );
@@ -422,7 +528,7 @@ fn pick_greedy(
         (Some(&(_, i, guide)), _) => replay(sim, guides, i, guide),
         (None, Some((_, i, guide))) => GuideRun {
             guide,
-            trace: sim.run_within(&mut strafer(&guides[i].path, &guide), budget),
+            trace: sim.run_within(&mut strafer(&guides[i], &guide), budget),
         },
         (None, None) => {
             let guide = GreedyGuide {
@@ -430,10 +536,11 @@ fn pick_greedy(
                 centre_line: false,
                 lookahead_units: GREEDY_LOOKAHEADS_UNITS[0],
                 speed_cap_ups: None,
+                corner_bend_units: None,
             };
             GuideRun {
                 guide,
-                trace: sim.run_within(&mut strafer(&guides[0].path, &guide), budget),
+                trace: sim.run_within(&mut strafer(&guides[0], &guide), budget),
             }
         }
     };
@@ -451,6 +558,8 @@ fn is_clean(t: &Trace) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optimise::planner::planning_inputs;
+    use crate::scene::generate::{staircase, Staircase};
 
     #[test]
     fn a_corner_wrapped_by_several_vertices_counts_as_one_turn() {
@@ -470,5 +579,87 @@ mod tests {
         path.push(last + Vec2::from_angle(heading) * 500.0);
         let sharpest = sharpest_corner_rad(&path);
         assert!((sharpest - 150f64.to_radians()).abs() < 1e-9, "{sharpest}");
+        // The corners in order, where they start and end along the path, and their turns.
+        let corners = path_corners(&path);
+        assert_eq!(corners.len(), 2, "{corners:?}");
+        let want = [(500.0, 520.0, 150.0), (1030.0, 1030.0, -60.0)];
+        for (c, (first, last, turn)) in corners.iter().zip(want) {
+            assert!((c.first_units - first).abs() < 1e-9, "{c:?}");
+            assert!((c.last_units - last).abs() < 1e-9, "{c:?}");
+            assert!((c.turn_rad - f64::to_radians(turn)).abs() < 1e-9, "{c:?}");
+        }
+    }
+
+    #[test]
+    fn each_corner_has_the_speed_of_its_own_arc_over_its_tangent_lengths() {
+        // A staircase of right-angle turns; its shortest path cuts each corner's diagonal a little
+        // differently, so each corner has its own turn and speed.
+        let spec = Staircase {
+            corners: 3,
+            ..Staircase::default()
+        };
+        let scene = staircase(&spec).unwrap_or_else(|e| panic!("{e}")).scene;
+        let (_, bound, _) = planning_inputs(&scene);
+        let width = 64.0;
+        let corners = path_corners(&bound.path);
+        let speeds = corner_speeds(&scene, &bound.path, width);
+        assert_eq!((corners.len(), speeds.corners.len()), (3, 3), "{speeds:?}");
+        for (c, corner) in speeds.corners.iter().zip(&corners) {
+            let turn = corner.turn_rad.abs();
+            assert!(
+                turn > 1.0 && turn < std::f64::consts::FRAC_PI_2,
+                "{corner:?}"
+            );
+            let r = turn_arc_radius(width, turn);
+            let v = speed_for_radius(&scene.vars, r).unwrap_or_else(|e| panic!("{e}"));
+            assert!((c.speed_ups - v).abs() < 1e-9, "{c:?} against {v}");
+            // Under a right angle the tangent length is r tan(turn / 2), both sides.
+            let half = r * (0.5 * turn).tan();
+            assert!(
+                (corner.first_units - c.start_units - half).abs() < 1e-9,
+                "{c:?}"
+            );
+            assert!(
+                (c.end_units - corner.last_units - half).abs() < 1e-9,
+                "{c:?}"
+            );
+        }
+        // A sharper turn, a slower corner.
+        let mut by_turn: Vec<(f64, f64)> = corners
+            .iter()
+            .zip(&speeds.corners)
+            .map(|(c, s)| (c.turn_rad.abs(), s.speed_ups))
+            .collect();
+        by_turn.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert!(by_turn.windows(2).all(|w| w[1].1 < w[0].1), "{by_turn:?}");
+        let gamma1 = air_law(&scene.vars).gamma1;
+        assert!((speeds.braking_ups_per_s - gamma1 * 100.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn on_a_staircase_the_strafer_with_corner_speeds_beats_every_single_cap() {
+        // One cap is the sharpest corner's speed held on every leg; corner speeds free the legs between.
+        let spec = Staircase {
+            corners: 5,
+            ..Staircase::default()
+        };
+        let scene = staircase(&spec).unwrap_or_else(|e| panic!("{e}")).scene;
+        let (sim, bound, base) = planning_inputs(&scene);
+        let guide = base.greedy.guide;
+        assert!(guide.corner_bend_units.is_some(), "{guide}");
+        assert!(base.greedy.trace.feasible(), "{guide}");
+        let shortest = &guide_paths(&scene, &bound)[0].path;
+        let mut capped = u64::MAX;
+        for cap in corner_caps(&scene, &bound.path) {
+            for &la in &GREEDY_LOOKAHEADS_UNITS {
+                let mut g = Greedy::new(shortest.clone(), la).with_speed_cap(cap);
+                let t = sim.run(&mut g);
+                if let (true, Some(c)) = (t.feasible(), t.crossing) {
+                    capped = capped.min(c.frames);
+                }
+            }
+        }
+        let frames = base.greedy.trace.crossing.map_or(u64::MAX, |c| c.frames);
+        assert!(frames < capped, "{frames} against capped {capped}");
     }
 }

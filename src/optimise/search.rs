@@ -559,4 +559,3 @@ mod tests {
         assert_eq!(time_limit(2.5).ok(), Some(Duration::from_millis(2500)));
     }
 }
-

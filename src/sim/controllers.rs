@@ -73,6 +73,45 @@ pub struct Greedy {
     lookahead_units: f64,
     last_side: Side,
     speed_cap_ups: Option<f64>,
+    corner_speeds: Option<CornerSpeeds>,
+}
+
+/// A stretch of the guide path taken at a speed no higher than `speed_ups`: a corner, from
+/// `start_units` to `end_units` of arc length along the guide.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CornerSpeed {
+    /// Where the stretch starts, units of arc length along the guide.
+    pub start_units: f64,
+    /// Where it ends, units of arc length along the guide.
+    pub end_units: f64,
+    /// The highest speed on it, ups.
+    pub speed_ups: f64,
+}
+
+/// The speeds a strafer keeps under along its guide: each corner's, and before each corner no more than
+/// it can brake down from by the corner's start at `braking_ups_per_s` (`v^2 = v_c^2 + 2 a d`). After a
+/// corner's end it no longer counts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CornerSpeeds {
+    /// The corners, in any order.
+    pub corners: Vec<CornerSpeed>,
+    /// The deceleration braking gives, ups per second (docs/physics.md section 7: `gamma1` a frame).
+    pub braking_ups_per_s: f64,
+}
+
+impl CornerSpeeds {
+    /// The highest speed allowed at `s` units along the guide, ups; `None` where no corner ahead limits
+    /// it.
+    pub fn cap_at(&self, s: f64) -> Option<f64> {
+        self.corners
+            .iter()
+            .filter(|c| s <= c.end_units)
+            .map(|c| {
+                let before = (c.start_units - s).max(0.0);
+                (c.speed_ups * c.speed_ups + 2.0 * self.braking_ups_per_s * before).sqrt()
+            })
+            .min_by(f64::total_cmp)
+    }
 }
 
 impl Greedy {
@@ -92,6 +131,7 @@ impl Greedy {
             lookahead_units,
             last_side: Side::Right,
             speed_cap_ups: None,
+            corner_speeds: None,
         }
     }
 
@@ -101,6 +141,26 @@ impl Greedy {
     pub fn with_speed_cap(mut self, cap_ups: f64) -> Self {
         self.speed_cap_ups = Some(cap_ups);
         self
+    }
+
+    /// The same strafer keeping under `speeds` along its guide (with a speed cap, under both): it
+    /// accelerates as the plain strafer does between corners and holds or brakes as the capped one does
+    /// before and through them.
+    pub fn with_corner_speeds(mut self, speeds: CornerSpeeds) -> Self {
+        self.corner_speeds = Some(speeds);
+        self
+    }
+
+    /// The highest speed allowed at `pos`, ups, if any.
+    fn cap_at(&self, pos: Vec2) -> Option<f64> {
+        let corner = self
+            .corner_speeds
+            .as_ref()
+            .and_then(|c| c.cap_at(self.project(pos)));
+        match (self.speed_cap_ups, corner) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
     }
 
     /// The look-ahead distance, units.
@@ -152,9 +212,14 @@ impl Greedy {
 
 impl Controller for Greedy {
     fn name(&self) -> String {
+        let corners = if self.corner_speeds.is_some() {
+            "-corner-speeds"
+        } else {
+            ""
+        };
         match self.speed_cap_ups {
-            None => "greedy".to_string(),
-            Some(cap) => format!("greedy-capped-{cap:.0}"),
+            None => format!("greedy{corners}"),
+            Some(cap) => format!("greedy-capped-{cap:.0}{corners}"),
         }
     }
 
@@ -200,7 +265,7 @@ impl Greedy {
         side: Side,
         to_target: Vec2,
     ) -> Control {
-        match self.speed_cap_ups {
+        match self.cap_at(s.pos) {
             Some(cap) if s.speed() >= cap => {
                 let before = s.speed();
                 Control::from_wish(&strafe_wish(
@@ -320,4 +385,43 @@ pub fn best_capped_greedy_within(
         Budget::unlimited()
     };
     (sim.run_within(&mut make(la, cap), &replay_budget), la, cap)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_corner_speed_holds_through_its_corner_and_braking_distance_raises_it_before() {
+        let speeds = CornerSpeeds {
+            corners: vec![
+                CornerSpeed {
+                    start_units: 1000.0,
+                    end_units: 1200.0,
+                    speed_ups: 300.0,
+                },
+                CornerSpeed {
+                    start_units: 2000.0,
+                    end_units: 2100.0,
+                    speed_ups: 500.0,
+                },
+            ],
+            braking_ups_per_s: 800.0,
+        };
+        let near = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-9);
+        // Through the first corner: its own speed.
+        assert!(near(speeds.cap_at(1000.0), 300.0));
+        assert!(near(speeds.cap_at(1200.0), 300.0));
+        // 100 units before it: v^2 = 300^2 + 2 * 800 * 100.
+        assert!(near(speeds.cap_at(900.0), (90_000.0f64 + 160_000.0).sqrt()));
+        // Past it, the second corner's braking curve and then its speed; past both, no limit.
+        let between = (500.0f64 * 500.0 + 2.0 * 800.0 * 700.0).sqrt();
+        assert!(near(speeds.cap_at(1300.0), between));
+        assert!(near(speeds.cap_at(2050.0), 500.0));
+        assert_eq!(speeds.cap_at(2100.5), None);
+        // Far before both, the lower of the two curves.
+        let first = (300.0f64 * 300.0 + 2.0 * 800.0 * 1000.0).sqrt();
+        let second = (500.0f64 * 500.0 + 2.0 * 800.0 * 2000.0).sqrt();
+        assert!(near(speeds.cap_at(0.0), first.min(second)));
+    }
 }
