@@ -121,16 +121,24 @@ pub(super) fn plan_airborne(
     }
     // The final plan is a point of the certificate's problem too: where it is faster than the certificate
     // (the relaxed stage stopped short of its optimum), it is the last start, so that the certificate is
-    // never behind the plan.
+    // never behind the plan. The start is the plan as played ([`plan_as_start`]).
     let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
-    if let Some((_, _, plan)) = best.as_ref().filter(|b| behind(b.0)) {
-        certifier.add_start(planner, progress, plan.clone(), StartKind::Planned, lo);
+    if let Some((_, trace, _)) = best.as_ref().filter(|b| behind(b.0)) {
+        let start = plan_as_start(planner, trace);
+        certifier.add_start(planner, progress, start, StartKind::Planned, lo);
     }
     AirbornePlan {
         best,
         certifier,
         relaxed_found: true,
     }
+}
+
+/// A plan as played (`trace`, after the prefix) in planning controls. Not its planned controls: a plan
+/// whose controls end before the line is played on at maximum acceleration until it crosses, and those
+/// frames are part of the plan.
+fn plan_as_start(planner: &Planner, trace: &Trace) -> Vec<FrameControl> {
+    planner.warm_start(trace)
 }
 
 /// The warm starts of the certificate's greedy starts: the other clean greedy runs (not from a start at
@@ -241,5 +249,49 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
         if valid || planner.timed_out {
             break;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::budget::Budget;
+    use crate::optimise::planner::planning_inputs;
+    use crate::optimise::search::SearchSettings;
+    use crate::optimise::Quality;
+    use crate::scene::generate::{staircase, Staircase};
+    use crate::sim::Simulation;
+
+    #[test]
+    fn a_plan_whose_controls_end_short_of_the_line_starts_the_certificate_as_played() {
+        let spec = Staircase {
+            corners: 1,
+            ..Staircase::default()
+        };
+        let scene = staircase(&spec).unwrap_or_else(|e| panic!("{e}")).scene;
+        let (_, bound, base) = planning_inputs(&scene);
+        let seed = base.seed();
+        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let mut planner = Planner::new(&scene, &sim, &settings, &bound, seed, Budget::unlimited());
+        // The seed's controls cut five frames before its crossing: played, the plan goes on at maximum
+        // acceleration and crosses all the same.
+        let mut controls = planner.warm_start(seed);
+        let frames = controls.len();
+        controls.truncate(frames - 5);
+        assert!(planner.crossing_of(&controls).is_none());
+        let (t, trace) = quantised_and_verified(&mut planner, controls)
+            .unwrap_or_else(|| panic!("the cut plan is not valid"));
+        let played = trace.crossing.map_or(0, |c| c.frames);
+        // As played, the start crosses where the plan does (to the model's rounding).
+        let start = plan_as_start(&planner, &trace);
+        let own = planner
+            .crossing_of(&start)
+            .unwrap_or_else(|| panic!("the start does not cross"));
+        assert!(own.frames.abs_diff(played) <= 1, "{own:?} against {played}");
+        assert!(
+            (own.time - t).abs() < 0.5 * scene.frame_time_s(),
+            "{own:?} against {t}"
+        );
     }
 }
