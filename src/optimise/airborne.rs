@@ -62,8 +62,9 @@ struct Source {
     planning: bool,
 }
 
-/// The fastest valid exact plan so far: its crossing time (seconds), its f64 trace and its controls.
-pub(super) type BestPlan = Option<(f64, Trace, Vec<FrameControl>)>;
+/// The fastest valid exact plan so far: its crossing time (seconds) and its f64 trace (the plan as
+/// played: its controls are the trace's).
+pub(super) type BestPlan = Option<(f64, Trace)>;
 
 /// What the airborne stages found.
 pub(super) struct AirbornePlan {
@@ -121,10 +122,11 @@ pub(super) fn plan_airborne(
     }
     // The final plan is a point of the certificate's problem too: where it is faster than the certificate
     // (the relaxed stage stopped short of its optimum), it is the last start, so that the certificate is
-    // never behind the plan. The start is the plan as played ([`plan_as_start`]).
+    // never behind the plan. The start is the plan as played, not its planned controls: a plan whose
+    // controls end before the line is played on at maximum acceleration until it crosses.
     let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
-    if let Some((_, trace, _)) = best.as_ref().filter(|b| behind(b.0)) {
-        let start = plan_as_start(planner, trace);
+    if let Some((_, trace)) = best.as_ref().filter(|b| behind(b.0)) {
+        let start = planner.warm_start(trace);
         certifier.add_start(planner, progress, start, StartKind::Planned, lo);
     }
     AirbornePlan {
@@ -132,13 +134,6 @@ pub(super) fn plan_airborne(
         certifier,
         relaxed_found: true,
     }
-}
-
-/// A plan as played (`trace`, after the prefix) in planning controls. Not its planned controls: a plan
-/// whose controls end before the line is played on at maximum acceleration until it crosses, and those
-/// frames are part of the plan.
-fn plan_as_start(planner: &Planner, trace: &Trace) -> Vec<FrameControl> {
-    planner.warm_start(trace)
 }
 
 /// The warm starts of the certificate's greedy starts: the other clean greedy runs (not from a start at
@@ -237,12 +232,11 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
             margin_retries,
         );
         for plan in plans {
-            let controls = plan.controls;
-            if let Some((t, trace)) = quantised_and_verified(planner, controls.clone()) {
+            if let Some((t, trace)) = quantised_and_verified(planner, plan.controls) {
                 valid |= plan.primary;
                 let limit = best.as_ref().map_or(greedy_s, |b| b.0);
                 if t < limit {
-                    *best = Some((t, trace, controls));
+                    *best = Some((t, trace));
                 }
             }
         }
@@ -256,22 +250,15 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
 mod tests {
     use super::*;
     use crate::budget::Budget;
-    use crate::optimise::planner::planning_inputs;
+    use crate::optimise::planner::{planning_inputs, staircase_scene};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
-    use crate::scene::generate::{staircase, Staircase};
-    use crate::sim::Simulation;
 
     #[test]
     fn a_plan_whose_controls_end_short_of_the_line_starts_the_certificate_as_played() {
-        let spec = Staircase {
-            corners: 1,
-            ..Staircase::default()
-        };
-        let scene = staircase(&spec).unwrap_or_else(|e| panic!("{e}")).scene;
-        let (_, bound, base) = planning_inputs(&scene);
+        let scene = staircase_scene(1);
+        let (sim, bound, base) = planning_inputs(&scene);
         let seed = base.seed();
-        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
         let settings = SearchSettings::for_quality(Quality::Fast);
         let mut planner = Planner::new(&scene, &sim, &settings, &bound, seed, Budget::unlimited());
         // The seed's controls cut five frames before its crossing: played, the plan goes on at maximum
@@ -284,7 +271,7 @@ mod tests {
             .unwrap_or_else(|| panic!("the cut plan is not valid"));
         let played = trace.crossing.map_or(0, |c| c.frames);
         // As played, the start crosses where the plan does (to the model's rounding).
-        let start = plan_as_start(&planner, &trace);
+        let start = planner.warm_start(&trace);
         let own = planner
             .crossing_of(&start)
             .unwrap_or_else(|| panic!("the start does not cross"));

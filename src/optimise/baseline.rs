@@ -229,28 +229,6 @@ struct GuidePath {
     clearance_units: f64,
     centre_line: bool,
     path: Vec<Vec2>,
-    /// On airborne scenes, the corner speeds along it for each of [`CAP_WIDTHS_UNITS`] ([`corner_speeds`]).
-    corner_speeds: Vec<(f64, CornerSpeeds)>,
-}
-
-impl GuidePath {
-    /// The guide along `path`, with its corner speeds on airborne scenes.
-    fn new(scene: &Scene, clearance_units: f64, centre_line: bool, path: Vec<Vec2>) -> Self {
-        let corner_speeds = if scene.effects.is_air_only() {
-            CAP_WIDTHS_UNITS
-                .iter()
-                .map(|&w| (w, corner_speeds(scene, &path, w)))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        GuidePath {
-            clearance_units,
-            centre_line,
-            path,
-            corner_speeds,
-        }
-    }
 }
 
 /// How a greedy run keeps its speed down: a speed cap held once reached, or the corner speeds of bends of
@@ -264,10 +242,18 @@ enum SpeedLimit {
 /// The guide paths of `scene`: the shortest path (the lower bound's) and the paths kept each of
 /// [`GUIDE_CLEARANCES_UNITS`] off the walls where the corridor has room, then the centre line.
 fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
-    let mut guides = vec![GuidePath::new(scene, 0.0, false, bound.path.clone())];
+    let mut guides = vec![GuidePath {
+        clearance_units: 0.0,
+        centre_line: false,
+        path: bound.path.clone(),
+    }];
     for &extra in &GUIDE_CLEARANCES_UNITS[1..] {
         match clear_path(scene, extra) {
-            Some(path) => guides.push(GuidePath::new(scene, extra, false, path)),
+            Some(path) => guides.push(GuidePath {
+                clearance_units: extra,
+                centre_line: false,
+                path,
+            }),
             None => break,
         }
     }
@@ -276,7 +262,11 @@ fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
             .iter()
             .any(|g| (g.clearance_units - extra).abs() < 2.0 * CENTRE_LINE_TOL_UNITS);
         if !known {
-            guides.push(GuidePath::new(scene, extra, true, path));
+            guides.push(GuidePath {
+                clearance_units: extra,
+                centre_line: true,
+                path,
+            });
         }
     }
     guides
@@ -391,29 +381,32 @@ struct GuideRuns {
     clean: Vec<(f64, usize, GreedyGuide)>,
 }
 
-/// The greedy strafer along guide `path` with `guide`'s look-ahead, cap and corner speeds.
-fn strafer(path: &GuidePath, guide: &GreedyGuide) -> Greedy {
-    let mut g = Greedy::new(path.path.clone(), guide.lookahead_units);
+/// The greedy strafer along guide `path` with `guide`'s look-ahead and cap, and `corners`, the corner
+/// speeds of `guide.corner_bend_units` along `path` ([`corner_speeds`]).
+fn strafer(path: &[Vec2], guide: &GreedyGuide, corners: Option<&CornerSpeeds>) -> Greedy {
+    let mut g = Greedy::new(path.to_vec(), guide.lookahead_units);
     if let Some(cap) = guide.speed_cap_ups {
         g = g.with_speed_cap(cap);
     }
-    // The width is one of CAP_WIDTHS_UNITS copied into the guide: equal bit for bit.
-    let corners = guide.corner_bend_units.and_then(|w| {
-        path.corner_speeds
-            .iter()
-            .find(|(width, _)| width.to_bits() == w.to_bits())
-    });
-    if let Some((_, speeds)) = corners {
+    if let Some(speeds) = corners {
         g = g.with_corner_speeds(speeds.clone());
     }
     g
+}
+
+/// The strafer of `guide` along `path`, its corner speeds worked out for it.
+fn strafer_of(sim: &Simulation, path: &[Vec2], guide: &GreedyGuide) -> Greedy {
+    let corners = guide
+        .corner_bend_units
+        .map(|w| corner_speeds(sim.scene(), path, w));
+    strafer(path, guide, corners.as_ref())
 }
 
 /// Run `i`'s guide played again whole.
 fn replay(sim: &Simulation, guides: &[GuidePath], i: usize, guide: GreedyGuide) -> GuideRun {
     GuideRun {
         guide,
-        trace: sim.run(&mut strafer(&guides[i], &guide)),
+        trace: sim.run(&mut strafer_of(sim, &guides[i].path, &guide)),
     }
 }
 
@@ -442,6 +435,8 @@ fn sweep_guides(
             if limit.is_some() && i != 0 && i != last {
                 continue;
             }
+            // The corner speeds along this guide, the same at every look-ahead.
+            let corners = corner_bend_units.map(|w| corner_speeds(sim.scene(), &g.path, w));
             let mut best_clean: Option<(f64, usize, GreedyGuide)> = None;
             let mut best_valid: Option<(f64, usize, GreedyGuide)> = None;
             // Ranks how far along this guide an unfinished run got.
@@ -458,7 +453,7 @@ fn sweep_guides(
                     corner_bend_units,
                 };
                 let run = sim.run_summary_broken_until(
-                    &mut strafer(g, &guide),
+                    &mut strafer(&g.path, &guide, corners.as_ref()),
                     budget,
                     broken_frame_limit,
                 );
@@ -528,7 +523,7 @@ fn pick_greedy(
         (Some(&(_, i, guide)), _) => replay(sim, guides, i, guide),
         (None, Some((_, i, guide))) => GuideRun {
             guide,
-            trace: sim.run_within(&mut strafer(&guides[i], &guide), budget),
+            trace: sim.run_within(&mut strafer_of(sim, &guides[i].path, &guide), budget),
         },
         (None, None) => {
             let guide = GreedyGuide {
@@ -540,7 +535,7 @@ fn pick_greedy(
             };
             GuideRun {
                 guide,
-                trace: sim.run_within(&mut strafer(&guides[0], &guide), budget),
+                trace: sim.run_within(&mut strafer_of(sim, &guides[0].path, &guide), budget),
             }
         }
     };
@@ -558,8 +553,7 @@ fn is_clean(t: &Trace) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimise::planner::planning_inputs;
-    use crate::scene::generate::{staircase, Staircase};
+    use crate::optimise::planner::{planning_inputs, staircase_scene};
 
     #[test]
     fn a_corner_wrapped_by_several_vertices_counts_as_one_turn() {
@@ -594,11 +588,7 @@ mod tests {
     fn each_corner_has_the_speed_of_its_own_arc_over_its_tangent_lengths() {
         // A staircase of right-angle turns; its shortest path cuts each corner's diagonal a little
         // differently, so each corner has its own turn and speed.
-        let spec = Staircase {
-            corners: 3,
-            ..Staircase::default()
-        };
-        let scene = staircase(&spec).unwrap_or_else(|e| panic!("{e}")).scene;
+        let scene = staircase_scene(3);
         let (_, bound, _) = planning_inputs(&scene);
         let width = 64.0;
         let corners = path_corners(&bound.path);
@@ -639,11 +629,7 @@ mod tests {
     #[test]
     fn on_a_staircase_the_strafer_with_corner_speeds_beats_every_single_cap() {
         // One cap is the sharpest corner's speed held on every leg; corner speeds free the legs between.
-        let spec = Staircase {
-            corners: 5,
-            ..Staircase::default()
-        };
-        let scene = staircase(&spec).unwrap_or_else(|e| panic!("{e}")).scene;
+        let scene = staircase_scene(5);
         let (sim, bound, base) = planning_inputs(&scene);
         let guide = base.greedy.guide;
         assert!(guide.corner_bend_units.is_some(), "{guide}");

@@ -256,6 +256,17 @@ pub(super) fn planning_inputs(
     (sim, bound, base)
 }
 
+/// The default staircase (`scene::generate::Staircase`) of `corners` corners, for the tests of the stages.
+#[cfg(test)]
+pub(super) fn staircase_scene(corners: u32) -> Scene {
+    use crate::scene::generate::{staircase, Staircase};
+    let spec = Staircase {
+        corners,
+        ..Staircase::default()
+    };
+    staircase(&spec).unwrap_or_else(|e| panic!("{e}")).scene
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -349,10 +349,9 @@ impl Certifier {
 mod tests {
     use super::*;
     use crate::budget::Budget;
-    use crate::optimise::planner::planning_inputs;
+    use crate::optimise::planner::{planning_inputs, staircase_scene};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
-    use crate::scene::generate::{staircase, Staircase};
 
     /// A certifier that tried `tried` starts, reached the line at `times` (frame 100 at 100 fps, as a
     /// fraction through it), the fastest from start `best_index`.
@@ -398,12 +397,7 @@ mod tests {
     #[test]
     fn a_greedy_start_of_the_certificate_is_never_solved_over_more_frames_than_its_run() {
         // The first half of a one-corner staircase's greedy seed: the line is out of its reach.
-        let g = staircase(&Staircase {
-            corners: 1,
-            ..Staircase::default()
-        })
-        .unwrap_or_else(|e| panic!("{e}"));
-        let scene = g.scene;
+        let scene = staircase_scene(1);
         let (sim, bound, base) = planning_inputs(&scene);
         let budget = Budget::unlimited();
         let settings = SearchSettings::for_quality(Quality::Fast);

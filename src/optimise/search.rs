@@ -470,7 +470,7 @@ fn solve_once(
         .filter(|_| planner.timed_out)
         .map(|stage| SearchStatus::stopped(&budget, stage));
     let outcome = match found.best {
-        Some((t, trace, _)) => {
+        Some((t, trace)) => {
             let status = stopped.unwrap_or(SearchStatus::Converged {
                 gap: finisher.gap(t),
             });

@@ -151,12 +151,12 @@ impl Greedy {
         self
     }
 
-    /// The highest speed allowed at `pos`, ups, if any.
-    fn cap_at(&self, pos: Vec2) -> Option<f64> {
+    /// The highest speed allowed `here_units` along the guide, ups, if any.
+    fn cap_at(&self, here_units: f64) -> Option<f64> {
         let corner = self
             .corner_speeds
             .as_ref()
-            .and_then(|c| c.cap_at(self.project(pos)));
+            .and_then(|c| c.cap_at(here_units));
         match (self.speed_cap_ups, corner) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
@@ -224,8 +224,11 @@ impl Controller for Greedy {
     }
 
     fn control(&mut self, _frame: u64, s: &PlayerState, sim: &Simulation) -> Control {
-        let (side, to_target) = self.steer(s, sim);
-        self.strafe(s, sim, scene_keys(sim), side, to_target)
+        // Where the player is along the guide, found once for the steering and the speed limit.
+        let here_units = self.project(s.pos);
+        let (side, to_target) = self.steer_from(here_units, s, sim);
+        let cap = self.cap_at(here_units);
+        self.strafe(s, sim, scene_keys(sim), side, to_target, cap)
     }
 }
 
@@ -233,7 +236,11 @@ impl Greedy {
     /// The steering of a frame: the side that turns the velocity towards the look-ahead target, and the
     /// vector to that target (see the type's documentation).
     pub fn steer(&mut self, s: &PlayerState, sim: &Simulation) -> (Side, Vec2) {
-        let here = self.project(s.pos);
+        self.steer_from(self.project(s.pos), s, sim)
+    }
+
+    /// [`Greedy::steer`] from `here` units along the guide (the projection of `s.pos`).
+    fn steer_from(&mut self, here: f64, s: &PlayerState, sim: &Simulation) -> (Side, Vec2) {
         let mut lookahead = self.lookahead_units;
         let mut target = self.point_at(here + lookahead);
         for _ in 0..MAX_LOOKAHEAD_HALVINGS {
@@ -256,16 +263,17 @@ impl Greedy {
     }
 
     /// The strafe of a frame on `side` with `keys`: maximum acceleration (docs/physics.md section 6), or at the
-    /// speed cap the speed held (section 8), braking from above (section 7).
-    pub fn strafe(
+    /// speed cap `cap` (ups) the speed held (section 8), braking from above (section 7).
+    fn strafe(
         &self,
         s: &PlayerState,
         sim: &Simulation,
         keys: Wish,
         side: Side,
         to_target: Vec2,
+        cap: Option<f64>,
     ) -> Control {
-        match self.cap_at(s.pos) {
+        match cap {
             Some(cap) if s.speed() >= cap => {
                 let before = s.speed();
                 Control::from_wish(&strafe_wish(
