@@ -232,8 +232,13 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
             margin_retries,
         );
         for plan in plans {
+            let planned_s = planner.crossing_of(&plan.controls).map(|c| c.time);
+            let primary = plan.primary;
             if let Some((t, trace)) = quantised_and_verified(planner, plan.controls) {
-                valid |= plan.primary;
+                // A replay that fell half a frame behind its plan scraped a wall the margin did not
+                // keep it off: the next margin is tried as well.
+                let as_planned = planned_s.is_none_or(|p| t <= p + 0.5 * planner.fl.tau_s);
+                valid |= primary && as_planned;
                 let limit = best.as_ref().map_or(greedy_s, |b| b.0);
                 if t < limit {
                     *best = Some((t, trace));

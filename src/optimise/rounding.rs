@@ -14,12 +14,27 @@ pub(super) const ROUNDING_HORIZON_S: f64 = 0.05;
 pub(super) const ROUNDING_HORIZONS_S: [f64; 2] = [ROUNDING_HORIZON_S, 0.15];
 /// Side sequences kept by the rounding's beam search.
 const ROUNDING_BEAM: usize = 64;
+/// Bisections of `c` for a frame that turns onto the relaxed heading: the turn to `2^-30` of the
+/// frame's `c` range.
+const ON_TARGET_BISECTIONS: usize = 30;
+/// A relaxed side at least this large is at its bound: the relaxed line turns as fast as a frame can, and
+/// sides of `+-1` can no longer take back a heading error, only a frame that turns less. The relaxed
+/// sub-problems put a side on its bound to their solver's tolerance (about `1e-8`); sides within a
+/// thousandth of it drift a path by at most a thousandth of a turn a frame.
+const SATURATED_SIDE: f64 = 1.0 - 1e-3;
 
 /// Rounds relaxed sides to `+-1`: a beam search over side sequences that keeps the exact trajectory on the
-/// relaxed one. A sequence's cost adds, each frame, the squared position error and the squared distance
-/// its heading error would drift over `horizon_s` seconds. Rounding frame by frame keeps the heading error
-/// bounded but not zero-mean where the relaxed sides saturate, and a steady heading error of a few
-/// hundredths of a radian drifts the path by tens of units.
+/// relaxed one. A sequence's cost adds, each frame, the squared cross-track error and the squared distance
+/// its heading error would drift while it cannot be taken back: over `horizon_s` seconds, or to the end of
+/// a run of relaxed sides at their bound that the next frame starts or is in (there sides of `+-1` turn as
+/// the relaxed line does and keep whatever heading error they carry in). Rounding frame by frame keeps the
+/// heading error bounded but not zero-mean where the relaxed sides saturate, and a steady heading error of
+/// a few hundredths of a radian drifts the path by tens of units.
+///
+/// At such a run and the frame before it, each sequence may also play the frame that turns onto the
+/// relaxed heading exactly ([`on_target_frame`]), paying once for the speed it gains otherwise, as the
+/// distance that puts it off the line by the end of the plan. A relaxed side counts as at its bound
+/// from [`SATURATED_SIDE`].
 /// `None` when `budget` runs out first.
 pub(super) fn round_sides(
     start: &ModelState,
@@ -29,46 +44,238 @@ pub(super) fn round_sides(
     budget: &Budget,
 ) -> Option<Vec<FrameControl>> {
     let relaxed = rollout(start, controls, fl);
+    let frames = controls.len();
     // Beam entries: (cost, state, index into the history of choices).
-    let mut history: Vec<(usize, f64)> = Vec::with_capacity(controls.len() * ROUNDING_BEAM * 2);
+    let mut history: Vec<(usize, FrameControl)> = Vec::with_capacity(frames * ROUNDING_BEAM * 3);
     let mut beam: Vec<(f64, ModelState, usize)> = vec![(0.0, *start, usize::MAX)];
+    let held_s = saturated_runs_s(controls, fl.tau_s);
     for (k, u) in controls.iter().enumerate() {
         if k as u64 % FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
             return None;
         }
         let target = relaxed[k];
-        let mut next: Vec<(f64, ModelState, usize)> = Vec::with_capacity(beam.len() * 2);
+        let remaining_s = (frames - k - 1) as f64 * fl.tau_s;
+        let normal = crate::physics::Vec2::from_angle(target.heading).perp();
+        let mut next: Vec<(f64, ModelState, usize)> = Vec::with_capacity(beam.len() * 3);
+        let saturated = controls[k..(k + 2).min(frames)]
+            .iter()
+            .any(|v| v.sigma.abs() >= SATURATED_SIDE);
         for &(cost, x, h) in &beam {
-            for sigma in [1.0, -1.0] {
-                let y = frame(&x, FrameControl { sigma, c: u.c }, fl, false).0;
+            let on_target = saturated
+                .then(|| on_target_frame(&x, target.heading, u.c, fl))
+                .flatten();
+            let full_speed = frame(&x, *u, fl, false).0.speed;
+            let choices = [
+                FrameControl { sigma: 1.0, c: u.c },
+                FrameControl {
+                    sigma: -1.0,
+                    c: u.c,
+                },
+            ];
+            for choice in choices.into_iter().chain(on_target) {
+                let y = frame(&x, choice, fl, false).0;
                 // Cross-track error only: every side sequence falls behind the relaxed line along the
                 // track alike (the zigzag of alternating sides shortens each move by about
                 // 1 - cos(delta / 2)), which the polish of `c` then trades off.
-                let normal = crate::physics::Vec2::from_angle(target.heading).perp();
                 let cross = (y.pos - target.pos).dot(normal);
-                let dpos = cross * cross;
-                let drift = (y.heading - target.heading) * y.speed * horizon_s;
-                history.push((h, sigma));
-                next.push((cost + dpos + drift * drift, y, history.len() - 1));
+                let held = horizon_s.max(held_s.get(k + 1).copied().unwrap_or(0.0));
+                let drift = (y.heading - target.heading) * y.speed * held;
+                // What a frame that turned less changed, once: the speed it gained otherwise than
+                // the relaxed frame, as the distance that puts it off the line by the end of the plan.
+                let behind = (full_speed - y.speed) * remaining_s;
+                history.push((h, choice));
+                next.push((
+                    cost + cross * cross + drift * drift + behind * behind,
+                    y,
+                    history.len() - 1,
+                ));
             }
         }
         next.sort_by(|a, b| a.0.total_cmp(&b.0));
         next.truncate(ROUNDING_BEAM);
         beam = next;
     }
-    let mut sides = Vec::with_capacity(controls.len());
+    let mut rounded = Vec::with_capacity(frames);
     let mut h = beam.first().map_or(usize::MAX, |b| b.2);
     while h != usize::MAX {
-        let (parent, sigma) = history[h];
-        sides.push(sigma);
+        let (parent, u) = history[h];
+        rounded.push(u);
         h = parent;
     }
-    sides.reverse();
-    Some(
+    rounded.reverse();
+    Some(rounded)
+}
+
+/// Per frame, how long from it the relaxed sides stay at their bound, seconds (0 where they are not):
+/// a heading error the rounded plan carries into such a run stays through it.
+fn saturated_runs_s(controls: &[FrameControl], tau_s: f64) -> Vec<f64> {
+    let mut held = vec![0.0; controls.len()];
+    let mut run = 0.0;
+    for (k, u) in controls.iter().enumerate().rev() {
+        run = if u.sigma.abs() >= SATURATED_SIDE {
+            run + tau_s
+        } else {
+            0.0
+        };
+        held[k] = run;
+    }
+    held
+}
+
+/// The frame from `x` that turns the heading onto `heading` exactly, when a frame that turns less than the
+/// one of `c` can (a larger `c`, up to [`FrameLaw::c_exact_max`]): with its sides at `+-1`, the rounded
+/// heading alternates half a turn either side of a straight relaxed one, and where the relaxed sides then
+/// saturate through a turn that half turn stays, drifting the path sideways by half a turn times the
+/// turn's length. One such frame sets the phase; it gains speed otherwise, which the beam weighs. Only
+/// from a frame that does not brake (`c >= 0`): from there up to a coasting frame the turn falls as `c`
+/// rises (docs/physics.md section 6), so one bisection finds it; a braking frame slows for a reason the
+/// rounding cannot see.
+fn on_target_frame(x: &ModelState, heading: f64, c: f64, fl: &FrameLaw) -> Option<FrameControl> {
+    let wanted = heading - x.heading;
+    let turn = |c: f64| {
+        frame(x, FrameControl { sigma: 1.0, c }, fl, false)
+            .0
+            .heading
+            - x.heading
+    };
+    let c_top = fl.c_exact_max(x.speed);
+    if c < 0.0 || c_top <= c || wanted.abs() >= turn(c) || wanted.abs() <= turn(c_top) {
+        return None;
+    }
+    // The turn falls as `c` rises from the maximum-acceleration turn to a coasting frame.
+    let (mut lo, mut hi) = (c, c_top);
+    for _ in 0..ON_TARGET_BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        if turn(mid) > wanted.abs() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(FrameControl {
+        sigma: wanted.signum(),
+        c: 0.5 * (lo + hi),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::{curvature::air_law, MovementVars, Vec2};
+
+    fn law(fps: f64) -> FrameLaw {
+        let vars = MovementVars::goldsrc(fps);
+        FrameLaw {
+            tau_s: vars.frame_time_s(),
+            law: air_law(&vars),
+            side_key_speed: vars.side_key_speed,
+        }
+    }
+
+    fn start(speed: f64) -> ModelState {
+        ModelState {
+            pos: Vec2::ZERO,
+            speed,
+            heading: 0.0,
+        }
+    }
+
+    /// A straight of relaxed sides `0`, a frame of half a turn, then a turn at the bound: sides of `+-1`
+    /// meet the turn half a turn out of phase, whichever they choose.
+    fn straight_then_turn(
+        fl: &FrameLaw,
+        v: f64,
+        straight: usize,
+        turn: usize,
+    ) -> Vec<FrameControl> {
+        let mut controls = Vec::new();
+        let mut x = start(v);
+        for k in 0..straight + 1 + turn {
+            let sigma = match k.cmp(&straight) {
+                std::cmp::Ordering::Less => 0.0,
+                std::cmp::Ordering::Equal => -0.5,
+                std::cmp::Ordering::Greater => -1.0,
+            };
+            let u = FrameControl {
+                sigma,
+                c: fl.c_plan_max(x.speed),
+            };
+            controls.push(u);
+            x = frame(&x, u, fl, false).0;
+        }
         controls
+    }
+
+    #[test]
+    fn an_on_target_frame_turns_onto_the_heading_and_gains_less() {
+        for (fps, aa) in [(250.0, false), (100.0, true)] {
+            let mut fl = law(fps);
+            if aa {
+                // Air acceleration 100: the law's second case (gamma1 > L).
+                fl.law.gamma1 *= 10.0;
+            }
+            let x = start(450.0);
+            let c = fl.c_plan_max(x.speed);
+            let full = frame(&x, FrameControl { sigma: -1.0, c }, &fl, false).0;
+            let full_turn = x.heading - full.heading;
+            for share in [0.1, 0.5, 0.9] {
+                let wanted = -share * full_turn;
+                let u = on_target_frame(&x, wanted, c, &fl)
+                    .unwrap_or_else(|| panic!("{fps} fps: no frame turns {share} of a full turn"));
+                let y = frame(&x, u, &fl, false).0;
+                assert!(
+                    (y.heading - wanted).abs() < 1e-9 * full_turn,
+                    "{fps} {share}"
+                );
+                assert_eq!(u.sigma, -1.0);
+                assert!(u.c > c && y.speed < full.speed, "{fps} {share}: {u:?}");
+            }
+            // More than a full turn, and from a braking frame, there is none.
+            assert!(on_target_frame(&x, -1.5 * full_turn, c, &fl).is_none());
+            assert!(on_target_frame(&x, -0.5 * full_turn, -100.0, &fl).is_none());
+        }
+    }
+
+    #[test]
+    fn the_rounded_sides_meet_a_turn_at_the_bound_in_phase() {
+        // 250 fps, 450 ups: a 60-frame turn after a 200-frame straight and a half-turn frame. Sides of
+        // +-1 alone meet the turn with the heading half a turn (0.014 rad) off either way, and that error
+        // stays through the turn: 1.26 units off by its end.
+        let fl = law(250.0);
+        let x0 = start(450.0);
+        let controls = straight_then_turn(&fl, x0.speed, 200, 60);
+        let relaxed = rollout(&x0, &controls, &fl);
+        let rounded = round_sides(
+            &x0,
+            &controls,
+            &fl,
+            ROUNDING_HORIZON_S,
+            &Budget::unlimited(),
+        )
+        .unwrap_or_else(|| panic!("the unlimited budget ran out"));
+        let played = rollout(&x0, &rounded, &fl);
+        let worst = relaxed
             .iter()
-            .zip(sides)
-            .map(|(u, sigma)| FrameControl { sigma, c: u.c })
-            .collect(),
-    )
+            .zip(&played)
+            .map(|(r, p)| {
+                (p.pos - r.pos)
+                    .dot(Vec2::from_angle(r.heading).perp())
+                    .abs()
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 0.15,
+            "the rounded path is {worst} units off the relaxed one"
+        );
+        // The phase is set by frames that turn less (then slightly less again as the path, a little
+        // slower, turns a little faster), and all of them cost less speed than one frame gains.
+        assert!(rounded.iter().zip(&controls).any(|(r, u)| r.c > u.c));
+        let gain = frame(&x0, controls[0], &fl, false).0.speed - x0.speed;
+        let lost = relaxed[260].speed - played[260].speed;
+        assert!(
+            lost > 0.0 && lost < gain,
+            "{lost} ups lost, a frame gains {gain}"
+        );
+        assert!(rounded.iter().all(|u| u.sigma.abs() == 1.0));
+    }
 }
