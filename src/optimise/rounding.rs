@@ -60,29 +60,28 @@ pub(super) fn round_sides(
         let saturated = controls[k..(k + 2).min(frames)]
             .iter()
             .any(|v| v.sigma.abs() >= SATURATED_SIDE);
+        let held = horizon_s.max(held_s.get(k + 1).copied().unwrap_or(0.0));
         for &(cost, x, h) in &beam {
+            let sides = [1.0, -1.0].map(|sigma| (FrameControl { sigma, c: u.c }, false));
             let on_target = saturated
                 .then(|| on_target_frame(&x, target.heading, u.c, fl))
-                .flatten();
-            let full_speed = frame(&x, *u, fl, false).0.speed;
-            let choices = [
-                FrameControl { sigma: 1.0, c: u.c },
-                FrameControl {
-                    sigma: -1.0,
-                    c: u.c,
-                },
-            ];
-            for choice in choices.into_iter().chain(on_target) {
+                .flatten()
+                .map(|v| (v, true));
+            for (choice, turns_less) in sides.into_iter().chain(on_target) {
                 let y = frame(&x, choice, fl, false).0;
                 // Cross-track error only: every side sequence falls behind the relaxed line along the
                 // track alike (the zigzag of alternating sides shortens each move by about
                 // 1 - cos(delta / 2)), which the polish of `c` then trades off.
                 let cross = (y.pos - target.pos).dot(normal);
-                let held = horizon_s.max(held_s.get(k + 1).copied().unwrap_or(0.0));
                 let drift = (y.heading - target.heading) * y.speed * held;
-                // What a frame that turned less changed, once: the speed it gained otherwise than
-                // the relaxed frame, as the distance that puts it off the line by the end of the plan.
-                let behind = (full_speed - y.speed) * remaining_s;
+                // A frame that turns less pays once for the speed it gains otherwise than the relaxed
+                // frame, as the distance that puts it off the line by the end of the plan. Sides of
+                // `+-1` at the relaxed `c` gain what it gains (`V'` does not depend on the side).
+                let behind = if turns_less {
+                    (frame(&x, *u, fl, false).0.speed - y.speed) * remaining_s
+                } else {
+                    0.0
+                };
                 history.push((h, choice));
                 next.push((
                     cost + cross * cross + drift * drift + behind * behind,
