@@ -57,10 +57,11 @@ pub(super) fn round_sides(
         let remaining_s = (frames - k - 1) as f64 * fl.tau_s;
         let normal = crate::physics::Vec2::from_angle(target.heading).perp();
         let mut next: Vec<(f64, ModelState, usize)> = Vec::with_capacity(beam.len() * 3);
-        let saturated = controls[k..(k + 2).min(frames)]
-            .iter()
-            .any(|v| v.sigma.abs() >= SATURATED_SIDE);
-        let held = horizon_s.max(held_s.get(k + 1).copied().unwrap_or(0.0));
+        // The run of saturated sides the next frame starts or is in, seconds (0 if none); a frame
+        // that turns less is offered in such a run and the frame before it.
+        let next_run_s = held_s.get(k + 1).copied().unwrap_or(0.0);
+        let saturated = held_s[k] > 0.0 || next_run_s > 0.0;
+        let held = horizon_s.max(next_run_s);
         for &(cost, x, h) in &beam {
             let sides = [1.0, -1.0].map(|sigma| (FrameControl { sigma, c: u.c }, false));
             let on_target = saturated
