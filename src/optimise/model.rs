@@ -75,15 +75,21 @@ impl FrameLaw {
         self.law.l.min(BRAKE_COS_LIMIT * v).max(self.c_max(v))
     }
 
-    /// `c` at speed `v` kept out of the anglemod guard's band around the kink in case 1: a `c` above
-    /// [`FrameLaw::c_plan_max`] but less than as far above the kink goes down to `c_plan_max` (the frame
-    /// then gains what the guarded plan counts on); every other `c`, and every `c` in case 2, is kept.
-    pub fn under_the_guard(&self, c: f64, v: f64) -> f64 {
+    /// The anglemod guard's band around the kink at speed `v` in case 1, ups: from
+    /// [`FrameLaw::c_plan_max`] to as far above the kink, where the game's quantised yaw can put a frame on
+    /// either piece of the law; `None` in case 2 (no guard).
+    pub fn guard_band(&self, v: f64) -> Option<(f64, f64)> {
         let (guard, kink) = (self.c_plan_max(v), self.kink());
-        if guard < kink && c > guard && c < 2.0 * kink - guard {
-            guard
-        } else {
-            c
+        (guard < kink).then_some((guard, 2.0 * kink - guard))
+    }
+
+    /// `c` at speed `v` kept out of the anglemod guard's band ([`FrameLaw::guard_band`]): a `c` inside it
+    /// goes down to its lower edge, `c_plan_max` (the frame then gains what the guarded plan counts on);
+    /// every other `c`, and every `c` in case 2, is kept.
+    pub fn under_the_guard(&self, c: f64, v: f64) -> f64 {
+        match self.guard_band(v) {
+            Some((guard, top)) if c > guard && c < top => guard,
+            _ => c,
         }
     }
 

@@ -6,7 +6,7 @@
 //! the beam's tracking cost cannot rank, and every rounding is polished and verified: the search keeps the
 //! fastest.
 
-use super::model::{frame, rollout, FrameControl};
+use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState};
 use super::planner::Planner;
 use super::rounding::{round_sides, ROUNDING_HORIZONS_S};
 use super::scp::{model_crossing, ScpProblem, CLEAN_VIOLATION_UNITS};
@@ -115,8 +115,10 @@ fn polished_if_set(
 /// at the maximum-acceleration turn, as the relaxed plan it was rounded from; then, on from that, with
 /// frames that may turn less ([`super::model::FrameLaw::c_exact_max`]), which moves the sides' phase where
 /// they meet a turn. In the law's first case the second plan's frames left within the anglemod guard's
-/// band go back under it ([`super::model::FrameLaw::under_the_guard`]), which the model does not see, so
-/// both plans go on to be quantised and replayed, and the faster valid one is kept.
+/// band go back under it ([`super::model::FrameLaw::under_the_guard`]): each such frame then turns more
+/// than polished, and a few of them put a plan along a wall into it, so the plan is polished once more
+/// with every frame kept to its side of the band. Both plans go on to be quantised and replayed, and the
+/// faster valid one is kept.
 fn polished(
     planner: &mut Planner,
     exact: Vec<FrameControl>,
@@ -137,15 +139,22 @@ fn polished(
     }
     let pr = ScpProblem {
         turn_less: true,
+        anglemod_guard: false,
         ..planner.problem(margin, false, 1)
     };
     let mut turned = planner.stage(pr, exact.clone(), iters).0;
     let fl = planner.fl;
     if fl.has_kink_guard() {
-        let mut x = planner.start;
-        for u in turned.iter_mut() {
-            u.c = fl.under_the_guard(u.c, x.speed);
-            x = frame(&x, *u, &fl, false).0;
+        let guarded = under_the_guard(&planner.start, &turned, &fl);
+        let moved = guarded != turned;
+        turned = guarded;
+        if moved && !planner.timed_out {
+            let pr = ScpProblem {
+                turn_less: true,
+                ..planner.problem(margin, false, 1)
+            };
+            let repaired = planner.stage(pr, turned, iters).0;
+            turned = under_the_guard(&planner.start, &repaired, &fl);
         }
     }
     if turned == exact {
@@ -153,6 +162,27 @@ fn polished(
     } else {
         vec![turned, exact]
     }
+}
+
+/// `controls` with every frame's `c` out of the anglemod guard's band ([`FrameLaw::under_the_guard`]),
+/// at the speeds of its own trajectory.
+fn under_the_guard(
+    start: &ModelState,
+    controls: &[FrameControl],
+    fl: &FrameLaw,
+) -> Vec<FrameControl> {
+    let mut x = *start;
+    controls
+        .iter()
+        .map(|u| {
+            let u = FrameControl {
+                c: fl.under_the_guard(u.c, x.speed),
+                ..*u
+            };
+            x = frame(&x, u, fl, false).0;
+            u
+        })
+        .collect()
 }
 
 /// The relaxed plan re-solved at the wider `margin`, cut at its crossing, or one frame longer when it no
@@ -178,5 +208,94 @@ fn resolved_wider(
             longer.push(last);
             longer
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::budget::Budget;
+    use crate::optimise::planner::planning_inputs;
+    use crate::optimise::search::SearchSettings;
+    use crate::optimise::Quality;
+    use crate::scene::generate::{generate, GeneratorSettings};
+
+    /// Frames of `controls` whose `c` lies inside the guard's band at their own speed, by more than
+    /// `tol_ups`.
+    fn in_the_band(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw) -> Vec<usize> {
+        let tol_ups = 1e-3;
+        let mut x = *start;
+        let mut inside = Vec::new();
+        for (k, u) in controls.iter().enumerate() {
+            if let Some((guard, top)) = fl.guard_band(x.speed) {
+                if u.c > guard + tol_ups && u.c < top - tol_ups {
+                    inside.push(k);
+                }
+            }
+            x = frame(&x, *u, fl, false).0;
+        }
+        inside
+    }
+
+    #[test]
+    fn frames_that_turn_less_keep_to_their_side_of_the_guard_band() {
+        // Generated scene 28 of seed 11: 250 fps, air acceleration 10 (the law's first case, where the
+        // maximum-acceleration frame sits on the kink and plans keep half an anglemod step under it).
+        let g = generate(11, 28, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
+        let scene = g.scene;
+        let (sim, bound, base) = planning_inputs(&scene);
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let run = &base.clean[0].trace;
+        let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
+        let fl = planner.fl;
+        assert!(fl.has_kink_guard());
+        // The greedy run's sides out of the band, every fifth frame turning less, just above it.
+        let mut x = planner.start;
+        let mut plan = planner.warm_start(run);
+        for (k, u) in plan.iter_mut().enumerate() {
+            if let Some((_, top)) = fl.guard_band(x.speed) {
+                u.c = if k % 5 == 0 {
+                    top + 0.01
+                } else {
+                    fl.under_the_guard(u.c, x.speed)
+                };
+            }
+            x = frame(&x, *u, &fl, false).0;
+        }
+        assert_eq!(in_the_band(&planner.start, &plan, &fl), Vec::<usize>::new());
+        let above: Vec<usize> = (0..plan.len()).step_by(5).collect();
+        // A stage that may turn less and keeps to the band's sides: frames above it stay above, the
+        // others under it.
+        let pr = ScpProblem {
+            turn_less: true,
+            ..planner.problem(settings.margin_units, false, 1)
+        };
+        let kept = planner.stage(pr, plan.clone(), 5).0;
+        assert_ne!(kept, plan, "the stage did not move");
+        assert_eq!(in_the_band(&planner.start, &kept, &fl), Vec::<usize>::new());
+        let mut x = planner.start;
+        for (k, u) in kept.iter().enumerate() {
+            if let Some((guard, top)) = fl.guard_band(x.speed) {
+                let side_ok = if above.contains(&k) {
+                    u.c >= top - 1e-3
+                } else {
+                    u.c <= guard + 1e-3
+                };
+                assert!(
+                    side_ok,
+                    "frame {k}: c {} against the band ({guard}, {top})",
+                    u.c
+                );
+            }
+            x = frame(&x, *u, &fl, false).0;
+        }
+        // Free of the band, the same stage moves frames into it.
+        let pr = ScpProblem {
+            turn_less: true,
+            anglemod_guard: false,
+            ..planner.problem(settings.margin_units, false, 1)
+        };
+        let free = planner.stage(pr, plan, 5).0;
+        assert!(!in_the_band(&planner.start, &free, &fl).is_empty());
     }
 }

@@ -43,7 +43,8 @@ pub struct ScpProblem<'a> {
     /// off for the relaxed certificate, whose feasible set must hold every exact plan.
     pub(super) anglemod_guard: bool,
     /// With exact sides, whether a frame may turn less than the maximum-acceleration turn
-    /// ([`FrameLaw::c_exact_max`]); else `c` keeps under the guard as in the relaxed problem.
+    /// ([`FrameLaw::c_exact_max`]); else `c` keeps under the guard as in the relaxed problem. With
+    /// `anglemod_guard` too, each frame keeps to its side of the guard's band ([`FrameLaw::guard_band`]).
     pub(super) turn_less: bool,
 }
 
@@ -158,6 +159,13 @@ impl ScpProblem<'_> {
         } else {
             self.fl.c_max(v)
         }
+    }
+
+    /// The guard's band at speed `v` where frames that may turn less keep to their side of it.
+    fn guard_band_kept(&self, v: f64) -> Option<(f64, f64)> {
+        (self.turn_less && self.anglemod_guard && !self.relaxed)
+            .then(|| self.fl.guard_band(v))
+            .flatten()
     }
 
     /// Lowest `c` allowed at speed `v` ([`FrameLaw::c_min`]).
@@ -312,6 +320,15 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
                     lo = lo.min(u.c - kink);
                 } else {
                     hi = hi.min(kink - u.c);
+                }
+                // A frame keeps to its side of the guard's band: above the kink no lower than the band's
+                // top, else no higher than its bottom (one the speed's change put inside moves out only).
+                if let Some((guard, top)) = pr.guard_band_kept(speed) {
+                    if u.c > kink {
+                        lo = lo.min((u.c - top).max(0.0));
+                    } else {
+                        hi = hi.min((guard - u.c).max(0.0));
+                    }
                 }
                 c_range.push((lo, hi));
                 speed = lin.states[k].speed;
