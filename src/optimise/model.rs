@@ -18,7 +18,7 @@
 use crate::physics::{AccelLaw, Control, Vec2};
 
 /// One anglemod step of the yaw, radians (docs/physics.md section 1: `360 / 65536` degrees).
-const ANGLEMOD_STEP_RAD: f64 = std::f64::consts::TAU / 65536.0;
+pub(super) const ANGLEMOD_STEP_RAD: f64 = std::f64::consts::TAU / 65536.0;
 /// The strongest braking a plan uses, as `-cos theta` of the strafe angle (see [`FrameLaw::c_min`]).
 const BRAKE_COS_LIMIT: f64 = 0.95;
 use std::ops::{Add, Div, Mul, Sub};

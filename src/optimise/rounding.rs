@@ -1,7 +1,7 @@
 //! Rounding: from the relaxed plan's continuous sides to the game's `+-1` (docs/physics.md section 5: a
 //! frame's wish direction is on one side of the velocity or the other).
 
-use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState};
+use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState, ANGLEMOD_STEP_RAD};
 use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 
 /// How far ahead a heading error is weighed by the side rounding, seconds.
@@ -127,9 +127,12 @@ fn saturated_runs_s(controls: &[FrameControl], tau_s: f64) -> Vec<f64> {
 /// heading alternates half a turn either side of a straight relaxed one, and where the relaxed sides then
 /// saturate through a turn that half turn stays, drifting the path sideways by half a turn times the
 /// turn's length. One such frame sets the phase; it gains speed otherwise, which the beam weighs. Only
-/// from a frame that does not brake (`c >= 0`): from there up to a coasting frame the turn falls as `c`
-/// rises (docs/physics.md section 6), so one bisection finds it; a braking frame slows for a reason the
-/// rounding cannot see.
+/// from a frame that does not brake: from there up to a coasting frame the turn falls as `c` rises
+/// (docs/physics.md section 6), so one bisection finds it; a braking frame slows for a reason the
+/// rounding cannot see. A frame brakes when its strafe angle is more than an anglemod step past 90
+/// degrees (`c < -V q`): in the law's second case the maximum-acceleration frame is at 90 degrees
+/// (`c_max = 0`), where the relaxed stage leaves it only to its tolerance, a hair either side, which the
+/// game's yaw cannot tell apart.
 fn on_target_frame(x: &ModelState, heading: f64, c: f64, fl: &FrameLaw) -> Option<FrameControl> {
     let wanted = heading - x.heading;
     let turn = |c: f64| {
@@ -139,7 +142,8 @@ fn on_target_frame(x: &ModelState, heading: f64, c: f64, fl: &FrameLaw) -> Optio
             - x.heading
     };
     let c_top = fl.c_exact_max(x.speed);
-    if c < 0.0 || c_top <= c || wanted.abs() >= turn(c) || wanted.abs() <= turn(c_top) {
+    let braking = c < -ANGLEMOD_STEP_RAD * x.speed;
+    if braking || c_top <= c || wanted.abs() >= turn(c) || wanted.abs() <= turn(c_top) {
         return None;
     }
     // The turn falls as `c` rises from the maximum-acceleration turn to a coasting frame.
@@ -233,6 +237,10 @@ mod tests {
             // More than a full turn, and from a braking frame, there is none.
             assert!(on_target_frame(&x, -1.5 * full_turn, c, &fl).is_none());
             assert!(on_target_frame(&x, -0.5 * full_turn, -100.0, &fl).is_none());
+            // A frame a hair past the maximum-acceleration one, as the relaxed stage leaves it (in the
+            // second case at 90 degrees, `c = 0`), does not brake.
+            let hair = c - 0.1 * ANGLEMOD_STEP_RAD * x.speed;
+            assert!(on_target_frame(&x, -0.5 * full_turn, hair, &fl).is_some());
         }
     }
 
