@@ -2,13 +2,13 @@
 //! separating half-planes, a trust region, and slack so that every sub-problem is feasible. Solved by
 //! Clarabel as `min 0.5 z'Pz + q'z  s.t.  Az + s = b, s in K`.
 //!
-//! Variables, in order: per frame `k` the control change `(d sigma_k, d c_k / C_SCALE)`; per frame the
+//! Variables, in order: the control changes `(d sigma_k, d c_k / C_SCALE)` of the controls with room to
+//! move (a control with none, a side fixed at `+-1`, is left out: its change is zero); per frame the
 //! state change `dx_k = (d px, d py, d V, d psi)` after frame `k`; one slack per group of wall rows (the
 //! rows that keep one move clear). Rows: the linearised dynamics (zero cone, one block per frame:
-//! `dx_k - A_k dx_{k-1} - B_k du_k = 0`) and the controls with no room to move (`du = 0`), then
-//! inequalities (nonnegative cone): wall rows `-n . dp_k - s_g <= n . p_k - offset - margin` (`g` the
-//! row's group), slack signs, and the trust-region and bound rows on
-//! the other controls. The objective is minus the progress of the last position, the slack's weight,
+//! `dx_k - A_k dx_{k-1} - B_k du_k = 0`), then inequalities (nonnegative cone): wall rows
+//! `-n . dp_k - s_g <= n . p_k - offset - margin` (`g` the row's group), slack signs, and the
+//! trust-region and bound rows on the controls. The objective is minus the progress of the last position, the slack's weight,
 //! and with [`SubProblem::curvature`] the convexified curvature of the Lagrangian
 //! ([`super::lagrangian`]), which makes the model right to second order.
 
@@ -149,10 +149,32 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         });
         row_slack.push(slack);
     }
-    let nu = 2 * n;
+    // A control whose allowed change is empty (a side fixed at +-1, a frame held on the kink) is no
+    // variable at all: its change is zero. (A box of zero width has no interior, which costs the
+    // interior-point method many iterations; an equality row for it would only make the system larger.)
+    // Each control's allowed change `[-lo, hi]`, scaled.
+    let control_ranges = |k: usize| {
+        let (slo, shi) = sp.sigma_range[k];
+        let (clo, chi) = sp.c_range[k];
+        [
+            (slo.max(0.0), shi.max(0.0)),
+            (clo.max(0.0) / C_SCALE_UPS, chi.max(0.0) / C_SCALE_UPS),
+        ]
+    };
+    // The variable of control `j` of frame `k`, at `2 k + j`; `None`: fixed.
+    let mut control_var: Vec<Option<usize>> = Vec::with_capacity(2 * n);
+    let mut nu = 0;
+    for k in 0..n {
+        for (lo, hi) in control_ranges(k) {
+            control_var.push((lo + hi > FIXED_RANGE).then(|| {
+                nu += 1;
+                nu - 1
+            }));
+        }
+    }
+    let iu = |k: usize, j: usize| control_var[2 * k + j];
     let nx = 4 * n;
     let nvar = nu + nx + m_w;
-    let iu = |k: usize, j: usize| 2 * k + j;
     let ix = |k: usize, i: usize| nu + 4 * k + i;
     let is = |j: usize| nu + nx + j;
 
@@ -176,40 +198,14 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
             }
             for (j, &bb) in jac.b[i].iter().enumerate() {
                 let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
-                if bb != 0.0 {
+                if let (true, Some(var)) = (bb != 0.0, iu(k, j)) {
                     ri.push(row);
-                    ci.push(iu(k, j));
+                    ci.push(var);
                     vals.push(-bb * scale);
                 }
             }
             b.push(0.0);
             row += 1;
-        }
-    }
-    // A control whose allowed change is empty (a side fixed at +-1, a frame held on the kink) is fixed
-    // by an equality row: a box of zero width has no interior, which costs the interior-point method
-    // many iterations.
-    let control_ranges = |k: usize| {
-        let (slo, shi) = sp.sigma_range[k];
-        let (clo, chi) = sp.c_range[k];
-        [
-            (iu(k, 0), slo.max(0.0), shi.max(0.0)),
-            (
-                iu(k, 1),
-                clo.max(0.0) / C_SCALE_UPS,
-                chi.max(0.0) / C_SCALE_UPS,
-            ),
-        ]
-    };
-    for k in 0..n {
-        for (var, lo, hi) in control_ranges(k) {
-            if lo + hi <= FIXED_RANGE {
-                ri.push(row);
-                ci.push(var);
-                vals.push(1.0);
-                b.push(0.0);
-                row += 1;
-            }
         }
     }
     let n_eq = row;
@@ -231,12 +227,12 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         b.push(0.0);
         row += 1;
     }
-    // Trust region and bounds on the other controls.
+    // Trust region and bounds on the controls that may move.
     for k in 0..n {
-        for (var, lo, hi) in control_ranges(k) {
-            if lo + hi <= FIXED_RANGE {
+        for (j, (lo, hi)) in control_ranges(k).into_iter().enumerate() {
+            let Some(var) = iu(k, j) else {
                 continue;
-            }
+            };
             ri.push(row);
             ci.push(var);
             vals.push(1.0);
@@ -263,8 +259,8 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         [
             (k > 0).then(|| (ix(k.saturating_sub(1), 2), 1.0)),
             (k > 0).then(|| (ix(k.saturating_sub(1), 3), 1.0)),
-            Some((iu(k, 0), 1.0)),
-            Some((iu(k, 1), C_SCALE_UPS)),
+            iu(k, 0).map(|v| (v, 1.0)),
+            iu(k, 1).map(|v| (v, C_SCALE_UPS)),
         ]
     };
     if let Some(blocks) = sp.curvature {
@@ -345,7 +341,10 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         return SubStep::failed(status);
     }
     let du: Vec<(f64, f64)> = (0..n)
-        .map(|k| (x[iu(k, 0)], x[iu(k, 1)] * C_SCALE_UPS))
+        .map(|k| {
+            let change = |j: usize| iu(k, j).map_or(0.0, |v| x[v]);
+            (change(0), change(1) * C_SCALE_UPS)
+        })
         .collect();
     let progress_gain = if n > 0 {
         sp.progress_dir.x * x[ix(n - 1, 0)] + sp.progress_dir.y * x[ix(n - 1, 1)]
@@ -453,6 +452,40 @@ mod tests {
         // Progress is 0.01 per ups of c: c rises to its bound, +1 ups.
         assert!((r.du[0].1 - 1.0).abs() < 1e-6, "{:?}", r.du);
         assert!((r.predicted - 0.01).abs() < 1e-6, "{}", r.predicted);
+    }
+
+    #[test]
+    fn a_control_with_no_room_stays_and_the_others_step() {
+        // Two frames; every control moves the end position along +x by its own amount per unit (c per
+        // ups). Frame 0's side and frame 1's c have no room: they stay, and the others rise to their
+        // bounds. A control mapped to the wrong variable would move, or gain another's progress.
+        let jac = |b_sigma: f64, b_c: f64| {
+            let mut a = [[0.0; 4]; 4];
+            for (i, row) in a.iter_mut().enumerate() {
+                row[i] = 1.0;
+            }
+            FrameJacobian {
+                a,
+                b: [[b_sigma, b_c], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
+            }
+        };
+        let j = [jac(1.0, 2.0), jac(3.0, 4.0)];
+        let p = [Vec2::new(5.0, 0.0), Vec2::new(10.0, 0.0)];
+        let sigma_range = [(0.0, 0.0), (0.5, 0.5)];
+        let c_range = [(1.0, 1.0), (0.0, 0.0)];
+        let sp = SubProblem {
+            sigma_range: &sigma_range,
+            c_range: &c_range,
+            ..sub(&j, &p, &[], &sigma_range)
+        };
+        let r = solve(&sp);
+        assert_eq!(r.status, SubStepStatus::Solved { almost: false });
+        assert_eq!((r.du[0].0, r.du[1].1), (0.0, 0.0), "{:?}", r.du);
+        assert!((r.du[0].1 - 1.0).abs() < 1e-6, "{:?}", r.du);
+        assert!((r.du[1].0 - 0.5).abs() < 1e-6, "{:?}", r.du);
+        // 2 per ups of frame 0's c, 3 per unit of frame 1's side.
+        assert!((r.predicted - (2.0 + 1.5)).abs() < 1e-5, "{}", r.predicted);
+        assert_eq!(r.dynamics_duals.len(), 2);
     }
 
     #[test]
