@@ -65,22 +65,6 @@ pub struct SubProblem<'a> {
     pub curvature: Option<&'a [CurvatureBlock]>,
 }
 
-impl SubProblem<'_> {
-    /// Whether the sub-problem is a linear program in `c` alone: no curvature yet (a stage's first
-    /// iteration) and every side fixed (the polish). Clarabel closes its duality gap slowly there (150 to
-    /// 200 interior-point iterations at 3174 frames, against about 20 with curvature), while the stage needs
-    /// only its direction: the step is kept only if the merit confirms it, and the next sub-problem, curved,
-    /// refines it. So it is solved to a relative gap of [`LINEAR_IN_C_GAP_TOL`] (docs/design.md, "What a
-    /// sub-problem costs").
-    fn linear_in_c_alone(&self) -> bool {
-        self.curvature.is_none()
-            && self
-                .sigma_range
-                .iter()
-                .all(|&(lo, hi)| lo.max(0.0) + hi.max(0.0) <= FIXED_RANGE)
-    }
-}
-
 /// How a sub-problem ended, mapped from Clarabel's status in one place.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SubStepStatus {
@@ -127,10 +111,6 @@ impl SubStep {
 const SUBPROBLEM_GAP_TOL: f64 = 1e-6;
 /// Clarabel's feasibility tolerance on a sub-problem.
 const SUBPROBLEM_FEAS_TOL: f64 = 1e-7;
-
-/// Clarabel's relative duality gap tolerance on a linear sub-problem in `c` alone (see
-/// [`SubProblem::linear_in_c_alone`]).
-const LINEAR_IN_C_GAP_TOL: f64 = 1e-2;
 
 /// Interior-point iterations Clarabel may take on one sub-problem.
 pub const MAX_SUBPROBLEM_ITERATIONS: u32 = 200;
@@ -323,11 +303,7 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         // of a sub-problem for steps no better (docs/design.md, "What a sub-problem costs").
         .iterative_refinement_enable(false)
         .tol_gap_abs(SUBPROBLEM_GAP_TOL)
-        .tol_gap_rel(if sp.linear_in_c_alone() {
-            LINEAR_IN_C_GAP_TOL
-        } else {
-            SUBPROBLEM_GAP_TOL
-        })
+        .tol_gap_rel(SUBPROBLEM_GAP_TOL)
         .tol_feas(SUBPROBLEM_FEAS_TOL)
         .build()
     {
@@ -510,28 +486,6 @@ mod tests {
         // 2 per ups of frame 0's c, 3 per unit of frame 1's side.
         assert!((r.predicted - (2.0 + 1.5)).abs() < 1e-5, "{}", r.predicted);
         assert_eq!(r.dynamics_duals.len(), 2);
-    }
-
-    #[test]
-    fn only_a_first_polish_step_is_solved_to_the_loose_gap() {
-        // The loose gap is for the linear program in c alone: every side fixed and no curvature yet.
-        // A side with room to move (the relaxed stage) or curvature (a later iteration) keeps the
-        // common tolerance.
-        let (j, p, w) = one_frame(jacobian(0.01), 10.0);
-        let (fixed, free) = ([(0.0, 0.0)], [(1.0, 1.0)]);
-        let curvature = [[[0.0; 4]; 4]];
-        let case = |sigma: &[(f64, f64)], curved: bool| {
-            SubProblem {
-                sigma_range: sigma,
-                curvature: curved.then_some(&curvature[..]),
-                ..sub(&j, &p, &w, &free)
-            }
-            .linear_in_c_alone()
-        };
-        assert!(case(&fixed, false));
-        assert!(!case(&free, false));
-        assert!(!case(&fixed, true));
-        assert!(!case(&free, true));
     }
 
     #[test]
