@@ -44,33 +44,21 @@ pub(super) fn rounded_and_polished(
     for attempt in 0..=margin_retries {
         // The first horizon's plans decide whether a wider margin is needed; the others' are further
         // candidates, the sides' phase through the turns chosen otherwise.
-        let mut clear_and_reaching = false;
-        let mut first_sides: Option<Vec<FrameControl>> = None;
-        for (i, &horizon_s) in ROUNDING_HORIZONS_S.iter().enumerate() {
-            let Some(sides) = rounded(planner, &relaxed, horizon_s) else {
-                break;
-            };
-            // The same sides polish to the same plans.
-            if first_sides.as_ref() == Some(&sides) {
-                continue;
-            }
-            let primary = i == 0;
-            if primary {
-                first_sides = Some(sides.clone());
-            }
-            let plans = polished_if_set(planner, sides, final_margin);
-            clear_and_reaching |= primary
+        let roundings = distinct_roundings(planner, &relaxed);
+        let polished = polished_side_by_side(planner, roundings, final_margin);
+        let clear_and_reaching = polished.iter().any(|(primary, plans)| {
+            *primary
                 && plans.iter().any(|plan| {
                     let st = rollout(&planner.start, plan, &fl);
                     planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS
                         && model_crossing(&planner.start, &st, planner.scene).is_some()
-                });
-            candidates.extend(
-                plans
-                    .into_iter()
-                    .map(|controls| RoundedPlan { controls, primary }),
-            );
-        }
+                })
+        });
+        candidates.extend(polished.into_iter().flat_map(|(primary, plans)| {
+            plans
+                .into_iter()
+                .map(move |controls| RoundedPlan { controls, primary })
+        }));
         planner.note_cut(Stage::Rounding);
         if clear_and_reaching || attempt == margin_retries || planner.timed_out {
             break;
@@ -79,6 +67,70 @@ pub(super) fn rounded_and_polished(
         relaxed = resolved_wider(planner, relaxed, margin);
     }
     candidates
+}
+
+/// The sides of `relaxed` rounded at each horizon of [`ROUNDING_HORIZONS_S`] in order, each marked
+/// whether it is the first horizon's; a later horizon's rounding equal to the first is left out (the same
+/// sides polish to the same plans). Stops at the first horizon the budget cuts.
+fn distinct_roundings(
+    planner: &mut Planner,
+    relaxed: &[FrameControl],
+) -> Vec<(bool, Vec<FrameControl>)> {
+    let mut roundings: Vec<(bool, Vec<FrameControl>)> = Vec::new();
+    for (i, &horizon_s) in ROUNDING_HORIZONS_S.iter().enumerate() {
+        let Some(sides) = rounded(planner, relaxed, horizon_s) else {
+            break;
+        };
+        if roundings.first().is_some_and(|(_, first)| *first == sides) {
+            continue;
+        }
+        roundings.push((i == 0, sides));
+    }
+    roundings
+}
+
+/// Each rounding polished at `final_margin` ([`polished_if_set`]), in the order given, with whether it
+/// is the first horizon's. The roundings are independent, so all but the first are polished on threads
+/// of their own (forks of `planner`, whose work is added back) beside the first: on a long run the
+/// polish is most of the solve.
+fn polished_side_by_side(
+    planner: &mut Planner,
+    roundings: Vec<(bool, Vec<FrameControl>)>,
+    final_margin: f64,
+) -> Vec<(bool, Vec<Vec<FrameControl>>)> {
+    let mut roundings = roundings.into_iter();
+    let Some((first_primary, first_sides)) = roundings.next() else {
+        return Vec::new();
+    };
+    let forks: Vec<(bool, Vec<FrameControl>, Planner)> = roundings
+        .map(|(primary, sides)| (primary, sides, planner.fork()))
+        .collect();
+    let (first, others) = std::thread::scope(|scope| {
+        let handles: Vec<_> = forks
+            .into_iter()
+            .map(|(primary, sides, mut fork)| {
+                scope.spawn(move || {
+                    let plans = polished_if_set(&mut fork, sides, final_margin);
+                    (primary, plans, fork)
+                })
+            })
+            .collect();
+        let first = polished_if_set(planner, first_sides, final_margin);
+        let others: Vec<_> = handles
+            .into_iter()
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
+            .collect();
+        (first, others)
+    });
+    let mut polished = vec![(first_primary, first)];
+    for (primary, plans, fork) in others {
+        planner.join(&fork);
+        polished.push((primary, plans));
+    }
+    polished
 }
 
 /// The sides of `relaxed` rounded weighing heading errors over `horizon_s` seconds
@@ -215,7 +267,7 @@ fn resolved_wider(
 mod tests {
     use super::*;
     use crate::budget::Budget;
-    use crate::optimise::planner::planning_inputs;
+    use crate::optimise::planner::{planning_inputs, staircase_scene};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
     use crate::scene::generate::{generate, GeneratorSettings};
@@ -315,5 +367,35 @@ mod tests {
         };
         let free = planner.stage(pr, plan, 5).0;
         assert!(!in_the_band(&planner.start, &free, &fl).is_empty());
+    }
+
+    #[test]
+    fn roundings_polished_side_by_side_are_those_polished_one_after_the_other() {
+        let scene = staircase_scene(2);
+        let (sim, bound, base) = planning_inputs(&scene);
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let run = &base.clean[0].trace;
+        let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
+        let margin = settings.margin_units;
+        let warm = planner.warm_start(run);
+        let relaxed = planner.stage(planner.problem(margin, true, 1), warm, 25).0;
+        let roundings = distinct_roundings(&mut planner, &relaxed);
+        assert_eq!(roundings.len(), 2, "the horizons round the line alike");
+        let mut one_by_one = planner.fork();
+        let expected: Vec<(bool, Vec<Vec<FrameControl>>)> = roundings
+            .iter()
+            .map(|(primary, sides)| {
+                let plans = polished_if_set(&mut one_by_one, sides.clone(), margin);
+                (*primary, plans)
+            })
+            .collect();
+        let before = planner.stats.subproblems;
+        let side_by_side = polished_side_by_side(&mut planner, roundings, margin);
+        // The same plans in the same order (the first horizon's first), and every thread's work counted.
+        assert!(side_by_side == expected);
+        assert_eq!(
+            planner.stats.subproblems - before,
+            one_by_one.stats.subproblems
+        );
     }
 }
