@@ -3,8 +3,8 @@
 //! ran closer than the rounded zigzag allows), the relaxed plan is re-solved at the same frame count with a
 //! wider margin and rounded again. The sides are rounded at several horizons
 //! ([`super::rounding::ROUNDING_HORIZONS_S`]), each a choice of the sides' phase through the turns that
-//! the beam's tracking cost cannot rank, and every rounding is polished and verified: the search keeps the
-//! fastest.
+//! the beam's tracking cost cannot rank, and every rounding is polished (the distinct ones side by side,
+//! on threads of their own) and verified: the search keeps the fastest.
 
 use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState};
 use super::planner::Planner;

@@ -8,9 +8,9 @@
 //! rows that keep one move clear). Rows: the linearised dynamics (zero cone, one block per frame:
 //! `dx_k - A_k dx_{k-1} - B_k du_k = 0`), then inequalities (nonnegative cone): wall rows
 //! `-n . dp_k - s_g <= n . p_k - offset - margin` (`g` the row's group), slack signs, and the
-//! trust-region and bound rows on the controls. The objective is minus the progress of the last position, the slack's weight,
-//! and with [`SubProblem::curvature`] the convexified curvature of the Lagrangian
-//! ([`super::lagrangian`]), which makes the model right to second order.
+//! trust-region and bound rows on the controls. The objective is minus the progress of the last
+//! position, the slack's weight, and with [`SubProblem::curvature`] the convexified curvature of the
+//! Lagrangian ([`super::lagrangian`]), which makes the model right to second order.
 
 use super::lagrangian::CurvatureBlock;
 use super::model::FrameJacobian;
@@ -197,8 +197,11 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
                 }
             }
             for (j, &bb) in jac.b[i].iter().enumerate() {
-                let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
-                if let (true, Some(var)) = (bb != 0.0, iu(k, j)) {
+                if bb == 0.0 {
+                    continue;
+                }
+                if let Some(var) = iu(k, j) {
+                    let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
                     ri.push(row);
                     ci.push(var);
                     vals.push(-bb * scale);
