@@ -89,14 +89,10 @@ pub(super) fn plan_airborne(
 ) -> AirbornePlan {
     let margins = LineMargins::of(planner);
     let greedy_starts = certificate_greedy_starts(planner, base);
-    let forked = planner.fork();
-    let (mine, side) = std::thread::scope(|scope| {
-        let side = scope.spawn(move || certified_greedy_starts(forked, greedy_starts, lo));
-        let mine = lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress);
-        (mine, side.join())
+    let side = move |fork: &mut Planner| certified_greedy_starts(fork, greedy_starts, lo);
+    let (mine, side_certifiers) = planner.beside_forks(vec![side], |planner| {
+        lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress)
     });
-    let (side_certifier, forked) = side.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-    planner.join(&forked);
     // Without a relaxed line there is no plan for a certificate to be beside.
     let Some((mut certifier, mut best)) = mine else {
         return AirbornePlan {
@@ -105,7 +101,9 @@ pub(super) fn plan_airborne(
             relaxed_found: false,
         };
     };
-    certifier.absorb(side_certifier);
+    for side_certifier in side_certifiers {
+        certifier.absorb(side_certifier);
+    }
     // A greedy start whose relaxed line is faster than the relaxed plan's: its line, refined at the
     // planning margin, is rounded too.
     if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
@@ -152,18 +150,17 @@ fn certificate_greedy_starts(planner: &Planner, base: &Baseline) -> Vec<Vec<Fram
         .collect()
 }
 
-/// The certificate's greedy starts, solved by `planner` (a fork, on its own thread), and the planner
-/// with its work counts.
-fn certified_greedy_starts<'a>(
-    mut planner: Planner<'a>,
+/// The certificate's greedy starts, solved by `planner` (a fork, on its own thread).
+fn certified_greedy_starts(
+    planner: &mut Planner,
     starts: Vec<Vec<FrameControl>>,
     lo: usize,
-) -> (Certifier, Planner<'a>) {
+) -> Certifier {
     let mut certifier = Certifier::default();
     for warm in starts {
-        certifier.add_start(&mut planner, &mut |_| {}, warm, StartKind::Greedy, lo);
+        certifier.add_start(planner, &mut |_| {}, warm, StartKind::Greedy, lo);
     }
-    (certifier, planner)
+    certifier
 }
 
 /// The relaxed line, the certificate's start from it, the tight line, and the exact plans of both lines;

@@ -18,7 +18,15 @@
 use crate::physics::{AccelLaw, Control, Vec2};
 
 /// One anglemod step of the yaw, radians (docs/physics.md section 1: `360 / 65536` degrees).
-pub(super) const ANGLEMOD_STEP_RAD: f64 = std::f64::consts::TAU / 65536.0;
+const ANGLEMOD_STEP_RAD: f64 =
+    std::f64::consts::TAU / crate::physics::engine_exact::ANGLEMOD_STEPS as f64;
+
+/// The change of `c = V cos theta` that one anglemod step of the strafe angle makes near 90 degrees, at
+/// speed `v`, ups: `V q` (`q` = [`ANGLEMOD_STEP_RAD`]). The game's yaw cannot tell apart two plans of a
+/// frame closer than this.
+pub(super) fn anglemod_step_ups(v: f64) -> f64 {
+    v * ANGLEMOD_STEP_RAD
+}
 /// The strongest braking a plan uses, as `-cos theta` of the strafe angle (see [`FrameLaw::c_min`]).
 const BRAKE_COS_LIMIT: f64 = 0.95;
 use std::ops::{Add, Div, Mul, Sub};
@@ -58,7 +66,7 @@ impl FrameLaw {
         let AccelLaw { l, gamma1 } = self.law;
         let c = self.c_max(v);
         if gamma1 <= l && c >= self.kink() {
-            c - 0.5 * v * ANGLEMOD_STEP_RAD
+            c - 0.5 * anglemod_step_ups(v)
         } else {
             c
         }

@@ -119,6 +119,44 @@ impl<'a> Planner<'a> {
         self.cut_in = self.cut_in.or(forked.cut_in);
     }
 
+    /// `here` on this planner while each of `jobs` runs on a [`Planner::fork`] of it, on a thread of its
+    /// own; returns `here`'s result and the jobs' in their order, with the forks' work added back
+    /// ([`Planner::join`]). A job's panic is resumed on this thread.
+    pub(super) fn beside_forks<T, U, J>(
+        &mut self,
+        jobs: Vec<J>,
+        here: impl FnOnce(&mut Self) -> U,
+    ) -> (U, Vec<T>)
+    where
+        J: FnOnce(&mut Planner<'a>) -> T + Send,
+        T: Send,
+    {
+        let forks: Vec<(J, Planner<'a>)> = jobs.into_iter().map(|job| (job, self.fork())).collect();
+        let (mine, theirs) = std::thread::scope(|scope| {
+            let handles: Vec<_> = forks
+                .into_iter()
+                .map(|(job, mut fork)| scope.spawn(move || (job(&mut fork), fork)))
+                .collect();
+            let mine = here(self);
+            let theirs: Vec<(T, Planner<'a>)> = handles
+                .into_iter()
+                .map(|h| {
+                    h.join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                })
+                .collect();
+            (mine, theirs)
+        });
+        let results = theirs
+            .into_iter()
+            .map(|(result, fork)| {
+                self.join(&fork);
+                result
+            })
+            .collect();
+        (mine, results)
+    }
+
     /// The SCP problem at wall `margin` (units), with relaxed or fixed sides, over planning steps of
     /// `frames_per_knot` frames.
     pub(super) fn problem(

@@ -91,8 +91,8 @@ fn distinct_roundings(
 
 /// Each rounding polished at `final_margin` ([`polished_if_set`]), in the order given, with whether it
 /// is the first horizon's. The roundings are independent, so all but the first are polished on threads
-/// of their own (forks of `planner`, whose work is added back) beside the first: on a long run the
-/// polish is most of the solve.
+/// of their own beside the first ([`Planner::beside_forks`]): on a long run the polish is most of the
+/// solve.
 fn polished_side_by_side(
     planner: &mut Planner,
     roundings: Vec<(bool, Vec<FrameControl>)>,
@@ -102,35 +102,17 @@ fn polished_side_by_side(
     let Some((first_primary, first_sides)) = roundings.next() else {
         return Vec::new();
     };
-    let forks: Vec<(bool, Vec<FrameControl>, Planner)> = roundings
-        .map(|(primary, sides)| (primary, sides, planner.fork()))
+    let others: Vec<_> = roundings
+        .map(|(primary, sides)| {
+            move |fork: &mut Planner| (primary, polished_if_set(fork, sides, final_margin))
+        })
         .collect();
-    let (first, others) = std::thread::scope(|scope| {
-        let handles: Vec<_> = forks
-            .into_iter()
-            .map(|(primary, sides, mut fork)| {
-                scope.spawn(move || {
-                    let plans = polished_if_set(&mut fork, sides, final_margin);
-                    (primary, plans, fork)
-                })
-            })
-            .collect();
-        let first = polished_if_set(planner, first_sides, final_margin);
-        let others: Vec<_> = handles
-            .into_iter()
-            .map(|h| {
-                h.join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-            })
-            .collect();
-        (first, others)
+    let (first, others) = planner.beside_forks(others, |planner| {
+        polished_if_set(planner, first_sides, final_margin)
     });
-    let mut polished = vec![(first_primary, first)];
-    for (primary, plans, fork) in others {
-        planner.join(&fork);
-        polished.push((primary, plans));
-    }
-    polished
+    std::iter::once((first_primary, first))
+        .chain(others)
+        .collect()
 }
 
 /// The sides of `relaxed` rounded weighing heading errors over `horizon_s` seconds
