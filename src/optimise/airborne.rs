@@ -13,7 +13,7 @@ use super::baseline::Baseline;
 use super::model::FrameControl;
 use super::planner::Planner;
 use super::polish::{rounded_and_polished, MARGIN_RETRIES};
-use super::relaxed::{count_search, relaxed_plan, Certifier, Relaxation, StartKind};
+use super::relaxed::{count_search, relaxed_plan, Certifier, CoarseRuns, Relaxation, StartKind};
 use super::search::Progress;
 use super::verify::quantised_and_verified;
 use crate::sim::Trace;
@@ -181,6 +181,7 @@ fn lines_and_plans(
         n,
         lo,
         Relaxation::planning(margins.planning),
+        CoarseRuns::Long,
     )?;
     let mut certifier = Certifier::default();
     certifier.add_start(planner, progress, relaxed.clone(), StartKind::Planned, lo);

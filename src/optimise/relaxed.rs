@@ -1,8 +1,9 @@
 //! The relaxed stage: sides continuous in `[-1, 1]` (the limit of fast left/right alternation, see
 //! [`super::model`]), so that every exact plan is one of its points. Min-time is fixed-N maximal progress
 //! plus a search over N: SCP at a frame count N, then N lowered to the frame before the plan's crossing
-//! until the line can no longer be reached. On long runs the search first runs over knots of several
-//! frames played with one control (coarse to fine).
+//! until the line can no longer be reached. On long runs (and on the certificate's greedy starts of 200
+//! frames or more) the search first runs over knots of several frames played with one control (coarse to
+//! fine).
 
 use super::model::{rollout_knots, FrameControl};
 use super::planner::Planner;
@@ -15,8 +16,24 @@ use crate::sim::Crossing;
 /// same count before the count is given up.
 const MAX_CONTINUED_STAGES: usize = 3;
 
-/// About this many knots make the coarse stage (the planning steps of a 100 fps run of four seconds).
+/// About this many knots make the coarse stage of a long run (the planning steps of a 100 fps run of four
+/// seconds).
 const COARSE_KNOTS: usize = 400;
+
+/// About this many knots make the coarse stage of a certificate's greedy start too short for knots of two
+/// frames at [`COARSE_KNOTS`] (200 to 800 frames: knots of 2 to 7 frames). There a sub-problem over knots
+/// costs about a fifth of one over frames, and the descent from a greedy run, often a third to twice
+/// slower than the plan, is most of the start's work.
+const SHORT_RUN_COARSE_KNOTS: usize = 100;
+
+/// Which runs the relaxed stage plans over knots before frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum CoarseRuns {
+    /// Runs of 800 frames or more ([`COARSE_KNOTS`]).
+    Long,
+    /// Runs of 200 frames or more ([`SHORT_RUN_COARSE_KNOTS`] below 800).
+    AlsoShort,
+}
 
 /// Times a frame count that the line cannot be reached in is grown before the search gives up
 /// ([`super::planner::Planner::max_grow_tries`]).
@@ -58,16 +75,20 @@ impl Relaxation {
 const CERTIFICATE_MARGIN_UNITS: f64 = 0.002;
 
 /// Frames per knot of the coarse stage for a run of about `frames` frames: knots of several frames
-/// once the run is long enough that about [`COARSE_KNOTS`] knots cover it, else 1 (no coarse stage).
-pub(super) fn coarse_knot_frames(frames: usize) -> u32 {
-    u32::try_from(frames / COARSE_KNOTS)
-        .unwrap_or(u32::MAX)
-        .max(1)
+/// once the run is long enough that about [`COARSE_KNOTS`] knots cover it; with
+/// [`CoarseRuns::AlsoShort`], on shorter runs once about [`SHORT_RUN_COARSE_KNOTS`] do; else 1 (no coarse
+/// stage).
+pub(super) fn coarse_knot_frames(frames: usize, runs: CoarseRuns) -> u32 {
+    let per_knot = match (frames / COARSE_KNOTS, runs) {
+        (0 | 1, CoarseRuns::AlsoShort) => frames / SHORT_RUN_COARSE_KNOTS,
+        (long, _) => long,
+    };
+    u32::try_from(per_knot).unwrap_or(u32::MAX).max(1)
 }
 
 /// The relaxed plan at wall `margin` (units) from the warm start `controls`, whose line crossing is near
-/// frame `n`; no plan crosses before frame `lo` (the lower bound's). Coarse to fine on long runs. Returns
-/// the best clean plan, cut at its crossing frame.
+/// frame `n`; no plan crosses before frame `lo` (the lower bound's). Coarse to fine on the `coarse` runs.
+/// Returns the best clean plan, cut at its crossing frame.
 pub(super) fn relaxed_plan(
     planner: &mut Planner,
     progress: &mut dyn FnMut(Progress),
@@ -75,8 +96,9 @@ pub(super) fn relaxed_plan(
     mut n: usize,
     lo: usize,
     relaxation: Relaxation,
+    coarse: CoarseRuns,
 ) -> Option<Vec<FrameControl>> {
-    let knot_frames = coarse_knot_frames(n);
+    let knot_frames = coarse_knot_frames(n, coarse);
     if knot_frames > 1 {
         let m = knot_frames as usize;
         let knots: Vec<FrameControl> = controls[..n.min(controls.len())]
@@ -274,7 +296,15 @@ impl Certifier {
             StartKind::Planned => count_search(planner, progress, start, n, lo, relaxation, 1),
             StartKind::Greedy => {
                 let grow_tries = std::mem::replace(&mut planner.max_grow_tries, 0);
-                let plan = relaxed_plan(planner, progress, start, n, lo, relaxation);
+                let plan = relaxed_plan(
+                    planner,
+                    progress,
+                    start,
+                    n,
+                    lo,
+                    relaxation,
+                    CoarseRuns::AlsoShort,
+                );
                 planner.max_grow_tries = grow_tries;
                 plan
             }
@@ -418,5 +448,33 @@ mod tests {
         assert!(certifier.certificate().is_none(), "{counts:?}");
         // The planning search itself still grows a count it cannot reach the line in.
         assert_eq!(planner.max_grow_tries, MAX_GROW_TRIES);
+    }
+
+    #[test]
+    fn long_runs_and_greedy_starts_of_200_frames_or_more_are_planned_over_knots_first() {
+        // About 400 knots from 800 frames on; below, about 100 knots from 200 frames for the certificate's
+        // greedy starts only.
+        let cases = [
+            (150, 1, 1),
+            (199, 1, 1),
+            (200, 1, 2),
+            (450, 1, 4),
+            (799, 1, 7),
+            (800, 2, 2),
+            (3174, 7, 7),
+            (3368, 8, 8),
+        ];
+        for (frames, long, also_short) in cases {
+            assert_eq!(
+                coarse_knot_frames(frames, CoarseRuns::Long),
+                long,
+                "{frames}"
+            );
+            assert_eq!(
+                coarse_knot_frames(frames, CoarseRuns::AlsoShort),
+                also_short,
+                "{frames}"
+            );
+        }
     }
 }
