@@ -26,7 +26,7 @@ pub enum Command {
     Report(ReportArgs),
     /// Measure what accuracy costs in time: every level from the lower bound to the engine-exact plan.
     Bench(super::bench::BenchArgs),
-    /// Run every scene that carries an [expect] table and report whether a result got worse.
+    /// Run every scene that carries an `[expect]` table and report whether a result got worse.
     Check(CheckArgs),
     /// Serve the planner page on a local port: edit a corridor, see the optimal and greedy lines.
     Serve(ServeArgs),
@@ -42,7 +42,7 @@ pub struct CheckArgs {
     /// Scenes checked at once (default: the number of cores).
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
     pub jobs: Option<u16>,
-    /// Rewrite each scene's [expect] values from the current results (comments and layout kept).
+    /// Rewrite each scene's `[expect]` values from the current results (comments and layout kept).
     #[arg(long)]
     pub update: bool,
     /// Also write a JUnit XML report.
