@@ -12,8 +12,10 @@ use super::search::Progress;
 use crate::budget::Stage;
 use crate::sim::Crossing;
 
-/// Times a relaxed stage that stopped at its iteration cap without a clean crossing is continued at the
-/// same count before the count is given up.
+/// Times, in one count search, a relaxed stage that stopped at its iteration cap without a clean crossing
+/// is continued at its count before that count is given up: the budget is the whole search's, not each
+/// count's, so a start far from the line whose stages keep ending inside the margin stops at the count it
+/// has reached, short of its optimum (the certificate's spread then counts it as it stands).
 const MAX_CONTINUED_STAGES: usize = 3;
 
 /// About this many knots make the coarse stage of a long run (the planning steps of a 100 fps run of four
