@@ -16,6 +16,7 @@
 //! about `|v|` per radian near the best angle); `(sigma, c)` are not.
 
 use crate::physics::{AccelLaw, Control, Vec2};
+use std::ops::{Add, Div, Mul, Sub};
 
 /// One anglemod step of the yaw, radians (docs/physics.md section 1: `360 / 65536` degrees).
 const ANGLEMOD_STEP_RAD: f64 =
@@ -27,9 +28,9 @@ const ANGLEMOD_STEP_RAD: f64 =
 pub(super) fn anglemod_step_ups(v: f64) -> f64 {
     v * ANGLEMOD_STEP_RAD
 }
+
 /// The strongest braking a plan uses, as `-cos theta` of the strafe angle (see [`FrameLaw::c_min`]).
 const BRAKE_COS_LIMIT: f64 = 0.95;
-use std::ops::{Add, Div, Mul, Sub};
 
 /// The constants of one airborne frame: frame time and the acceleration law.
 #[derive(Clone, Copy, Debug, PartialEq)]

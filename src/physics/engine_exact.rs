@@ -14,11 +14,14 @@ use serde::Serialize;
 /// Number of anglemod steps in a full turn.
 pub const ANGLEMOD_STEPS: u32 = 65536;
 
+/// One anglemod step, degrees: `360 / 65536`.
+const ANGLEMOD_STEP_DEG: f64 = 360.0 / ANGLEMOD_STEPS as f64;
+
 /// The game's anglemod of a yaw in degrees (docs/physics.md section 1): the angle truncated towards zero to a
 /// multiple of `360/65536` degrees and wrapped into `[0, 360)`. Computed as the game does: the `float`
 /// argument promoted to `double`, the result stored as `float`.
 pub fn anglemod_deg(yaw_deg: f32) -> f32 {
-    let step = 360.0 / f64::from(ANGLEMOD_STEPS);
+    let step = ANGLEMOD_STEP_DEG;
     let scaled = f64::from(yaw_deg) * (f64::from(ANGLEMOD_STEPS) / 360.0);
     // `as i64` truncates towards zero and saturates, like a C cast for in-range values.
     let index = (scaled as i64) & i64::from(ANGLEMOD_STEPS - 1);
@@ -43,7 +46,7 @@ pub fn engine_wish(control: &Control) -> Wish<f32> {
 /// The planning yaw (radians) that anglemod leaves unchanged and that is nearest to `yaw_rad`: planning on
 /// these yaws makes the plan and the game see the same view direction (up to `f32` rounding).
 pub fn quantise_yaw_rad(yaw_rad: f64) -> f64 {
-    let step = 360.0 / f64::from(ANGLEMOD_STEPS);
+    let step = ANGLEMOD_STEP_DEG;
     let deg = yaw_rad.to_degrees();
     // Round to the nearest step, then nudge half a step's millionth up so the f32 truncation lands on it.
     let k = (deg / step).round();
@@ -53,7 +56,7 @@ pub fn quantise_yaw_rad(yaw_rad: f64) -> f64 {
 /// The two yaws on anglemod steps either side of `yaw_rad` (equal when it is on a step), each surviving
 /// anglemod unchanged: a planner picks between them to steer the game's quantised view.
 pub fn anglemod_bracket(yaw_rad: f64) -> (f64, f64) {
-    let step = 360.0 / f64::from(ANGLEMOD_STEPS);
+    let step = ANGLEMOD_STEP_DEG;
     let k = yaw_rad.to_degrees() / step;
     let (lo, hi) = (k.floor(), k.ceil());
     (
