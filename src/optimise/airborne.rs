@@ -164,7 +164,9 @@ fn certified_greedy_starts(
 }
 
 /// The relaxed line, the certificate's start from it, the tight line, and the exact plans of both lines;
-/// `None` when the relaxed stage found no line.
+/// `None` when the relaxed stage found no line. The certificate's start from the relaxed line is solved
+/// on a fork beside the tight line and the exact plans: both begin at the relaxed line and neither needs
+/// the other.
 fn lines_and_plans(
     planner: &mut Planner,
     warm: Vec<FrameControl>,
@@ -183,8 +185,28 @@ fn lines_and_plans(
         Relaxation::planning(margins.planning),
         CoarseRuns::Long,
     )?;
-    let mut certifier = Certifier::default();
-    certifier.add_start(planner, progress, relaxed.clone(), StartKind::Planned, lo);
+    let start = relaxed.clone();
+    let certify = move |fork: &mut Planner| {
+        let mut certifier = Certifier::default();
+        certifier.add_start(fork, &mut |_| {}, start, StartKind::Planned, lo);
+        certifier
+    };
+    let (best, certifiers) = planner.beside_forks(vec![certify], |planner| {
+        exact_plans_of_both_lines(planner, relaxed, lo, margins, greedy_s, progress)
+    });
+    let certifier = certifiers.into_iter().next().unwrap_or_default();
+    Some((certifier, best))
+}
+
+/// The tight line refined from the relaxed one, and the exact plans of both lines.
+fn exact_plans_of_both_lines(
+    planner: &mut Planner,
+    relaxed: Vec<FrameControl>,
+    lo: usize,
+    margins: LineMargins,
+    greedy_s: f64,
+    progress: &mut dyn FnMut(Progress),
+) -> BestPlan {
     let mut sources = vec![Source {
         line: relaxed.clone(),
         margin: margins.planning,
@@ -206,7 +228,7 @@ fn lines_and_plans(
     for source in &sources {
         exact_plans(planner, source, greedy_s, &mut best);
     }
-    Some((certifier, best))
+    best
 }
 
 /// Stages 3 and 4 for one relaxed line: rounded, polished, quantised and verified, first at the settings'
