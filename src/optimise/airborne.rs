@@ -13,7 +13,9 @@ use super::baseline::Baseline;
 use super::model::FrameControl;
 use super::planner::Planner;
 use super::polish::{rounded_and_polished, MARGIN_RETRIES};
-use super::relaxed::{count_search, relaxed_plan, Certifier, CoarseRuns, Relaxation, StartKind};
+use super::relaxed::{
+    count_search, relaxed_plan, Certifier, CountSearch, Descent, Relaxation, StartKind,
+};
 use super::search::Progress;
 use super::verify::quantised_and_verified;
 use crate::sim::Trace;
@@ -108,8 +110,8 @@ pub(super) fn plan_airborne(
     // planning margin, is rounded too.
     if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
         let (controls, n) = (plan.controls.clone(), plan.controls.len());
-        let relaxation = Relaxation::planning(margins.planning);
-        if let Some(line) = count_search(planner, progress, controls, n, lo, relaxation, 1) {
+        let search = CountSearch::per_frame(Relaxation::planning(margins.planning));
+        if let Some(line) = count_search(planner, progress, controls, n, lo, search) {
             let source = Source {
                 line,
                 margin: margins.planning,
@@ -183,7 +185,7 @@ fn lines_and_plans(
         n,
         lo,
         Relaxation::planning(margins.planning),
-        CoarseRuns::Long,
+        Descent::PLAN,
     )?;
     let start = relaxed.clone();
     let certify = move |fork: &mut Planner| {
@@ -214,8 +216,8 @@ fn exact_plans_of_both_lines(
     }];
     if let Some(tight) = margins.tight {
         let n = relaxed.len();
-        let relaxation = Relaxation::planning(tight);
-        if let Some(line) = count_search(planner, progress, relaxed, n, lo, relaxation, 1) {
+        let search = CountSearch::per_frame(Relaxation::planning(tight));
+        if let Some(line) = count_search(planner, progress, relaxed, n, lo, search) {
             sources.push(Source {
                 line,
                 margin: tight,

@@ -34,9 +34,6 @@ pub(super) struct Planner<'a> {
     pub(super) timed_out: bool,
     /// The first stage the budget cut.
     pub(super) cut_in: Option<Stage>,
-    /// Times the count search may grow a count the line cannot be reached in: none for the
-    /// certificate's greedy starts ([`super::relaxed::StartKind::Greedy`]).
-    pub(super) max_grow_tries: usize,
 }
 
 /// The airborne frame law of a scene.
@@ -89,7 +86,6 @@ impl<'a> Planner<'a> {
             stats: SearchStats::default(),
             timed_out: false,
             cut_in: None,
-            max_grow_tries: super::relaxed::MAX_GROW_TRIES,
         }
     }
 
@@ -108,7 +104,6 @@ impl<'a> Planner<'a> {
             stats: SearchStats::default(),
             timed_out: false,
             cut_in: None,
-            max_grow_tries: self.max_grow_tries,
         }
     }
 

@@ -37,9 +37,56 @@ pub(super) enum CoarseRuns {
     AlsoShort,
 }
 
-/// Times a frame count that the line cannot be reached in is grown before the search gives up
-/// ([`super::planner::Planner::max_grow_tries`]).
-pub(super) const MAX_GROW_TRIES: usize = 3;
+/// Times a frame count that the line cannot be reached in is grown before the search gives up.
+const MAX_GROW_TRIES: usize = 3;
+
+/// How the relaxed stage descends from a start: which runs it plans over knots first, and how many times
+/// it grows a frame count that the line cannot be reached in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Descent {
+    /// The runs planned over knots before frames.
+    pub(super) coarse: CoarseRuns,
+    /// Times an unreachable count is grown (by a twentieth, at least two steps) before the search gives up.
+    pub(super) grow_tries: usize,
+}
+
+impl Descent {
+    /// The relaxed plan's: long runs over knots first, an unreachable count grown [`MAX_GROW_TRIES`] times.
+    pub(super) const PLAN: Descent = Descent {
+        coarse: CoarseRuns::Long,
+        grow_tries: MAX_GROW_TRIES,
+    };
+
+    /// A certificate's greedy start ([`StartKind::Greedy`]): over knots from 200 frames, and never over
+    /// more frames than the run's own.
+    pub(super) const GREEDY_START: Descent = Descent {
+        coarse: CoarseRuns::AlsoShort,
+        grow_tries: 0,
+    };
+}
+
+/// One search over frame counts: the relaxed problem, the planning step and how many times an unreachable
+/// count is grown.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct CountSearch {
+    /// The problem solved at each count.
+    pub(super) relaxation: Relaxation,
+    /// Frames per planning step (1: frame by frame).
+    pub(super) frames_per_knot: u32,
+    /// See [`Descent::grow_tries`].
+    pub(super) grow_tries: usize,
+}
+
+impl CountSearch {
+    /// Frame by frame, as the relaxed plan's search: an unreachable count grown [`MAX_GROW_TRIES`] times.
+    pub(super) fn per_frame(relaxation: Relaxation) -> Self {
+        CountSearch {
+            relaxation,
+            frames_per_knot: 1,
+            grow_tries: MAX_GROW_TRIES,
+        }
+    }
+}
 
 /// Which relaxed problem: the wall margin and whether `c` keeps under the anglemod guard.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,8 +136,8 @@ pub(super) fn coarse_knot_frames(frames: usize, runs: CoarseRuns) -> u32 {
 }
 
 /// The relaxed plan at wall `margin` (units) from the warm start `controls`, whose line crossing is near
-/// frame `n`; no plan crosses before frame `lo` (the lower bound's). Coarse to fine on the `coarse` runs.
-/// Returns the best clean plan, cut at its crossing frame.
+/// frame `n`; no plan crosses before frame `lo` (the lower bound's). Coarse to fine on the `descent`'s
+/// coarse runs. Returns the best clean plan, cut at its crossing frame.
 pub(super) fn relaxed_plan(
     planner: &mut Planner,
     progress: &mut dyn FnMut(Progress),
@@ -98,9 +145,9 @@ pub(super) fn relaxed_plan(
     mut n: usize,
     lo: usize,
     relaxation: Relaxation,
-    coarse: CoarseRuns,
+    descent: Descent,
 ) -> Option<Vec<FrameControl>> {
-    let knot_frames = coarse_knot_frames(n, coarse);
+    let knot_frames = coarse_knot_frames(n, descent.coarse);
     if knot_frames > 1 {
         let m = knot_frames as usize;
         let knots: Vec<FrameControl> = controls[..n.min(controls.len())]
@@ -124,11 +171,14 @@ pub(super) fn relaxed_plan(
             knots,
             count,
             lo / m,
-            Relaxation {
-                margin_units: relaxation.margin_units + sagitta,
-                ..relaxation
+            CountSearch {
+                relaxation: Relaxation {
+                    margin_units: relaxation.margin_units + sagitta,
+                    ..relaxation
+                },
+                frames_per_knot: knot_frames,
+                grow_tries: descent.grow_tries,
             },
-            knot_frames,
         ) {
             controls = plan
                 .iter()
@@ -137,22 +187,30 @@ pub(super) fn relaxed_plan(
             n = controls.len();
         }
     }
-    count_search(planner, progress, controls, n, lo, relaxation, 1)
+    let per_frame = CountSearch {
+        grow_tries: descent.grow_tries,
+        ..CountSearch::per_frame(relaxation)
+    };
+    count_search(planner, progress, controls, n, lo, per_frame)
 }
 
-/// The search over the number of planning steps (frames or knots of `frames_per_knot` frames): SCP at `n`
-/// steps from `controls`, then at one step fewer than the plan's crossing, until the line is no longer
-/// reached (or `lo` steps, below which the bound says it cannot be); more steps if the first count does
-/// not reach it. Returns the best clean plan, cut at its crossing step.
+/// The search over the number of planning steps (frames or knots, as `search` says): SCP at `n` steps
+/// from `controls`, then at one step fewer than the plan's crossing, until the line is no longer reached
+/// (or `lo` steps, below which the bound says it cannot be); more steps if the first count does not reach
+/// it (at most `search.grow_tries` times). Returns the best clean plan, cut at its crossing step.
 pub(super) fn count_search<'a>(
     planner: &mut Planner<'a>,
     progress: &mut dyn FnMut(Progress),
     mut controls: Vec<FrameControl>,
     mut n: usize,
     lo: usize,
-    relaxation: Relaxation,
-    frames_per_knot: u32,
+    search: CountSearch,
 ) -> Option<Vec<FrameControl>> {
+    let CountSearch {
+        relaxation,
+        frames_per_knot,
+        grow_tries: max_grow_tries,
+    } = search;
     let problem = |p: &Planner<'a>| relaxed_problem(p, relaxation, frames_per_knot);
     let fl = planner.fl;
     let relaxed_iters = planner.settings.relaxed_iters;
@@ -202,7 +260,7 @@ pub(super) fn count_search<'a>(
                 controls = c;
             }
             _ => {
-                if best.is_some() || grow_tries >= planner.max_grow_tries || planner.timed_out {
+                if best.is_some() || grow_tries >= max_grow_tries || planner.timed_out {
                     break;
                 }
                 // Not reachable at this count from this start: give it more steps.
@@ -296,20 +354,13 @@ impl Certifier {
         };
         let relaxation = Relaxation::certificate();
         let solved = match kind {
-            StartKind::Planned => count_search(planner, progress, start, n, lo, relaxation, 1),
+            StartKind::Planned => {
+                let search = CountSearch::per_frame(relaxation);
+                count_search(planner, progress, start, n, lo, search)
+            }
             StartKind::Greedy => {
-                let grow_tries = std::mem::replace(&mut planner.max_grow_tries, 0);
-                let plan = relaxed_plan(
-                    planner,
-                    progress,
-                    start,
-                    n,
-                    lo,
-                    relaxation,
-                    CoarseRuns::AlsoShort,
-                );
-                planner.max_grow_tries = grow_tries;
-                plan
+                let descent = Descent::GREEDY_START;
+                relaxed_plan(planner, progress, start, n, lo, relaxation, descent)
             }
         }
         .and_then(|p| planner.crossing_of(&p).map(|c| (c, p)));
@@ -449,8 +500,6 @@ mod tests {
         assert!(!counts.is_empty());
         assert!(counts.iter().all(|&c| c <= n), "{counts:?} against {n}");
         assert!(certifier.certificate().is_none(), "{counts:?}");
-        // The planning search itself still grows a count it cannot reach the line in.
-        assert_eq!(planner.max_grow_tries, MAX_GROW_TRIES);
     }
 
     #[test]
