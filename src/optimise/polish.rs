@@ -352,6 +352,43 @@ mod tests {
     }
 
     #[test]
+    fn a_polished_plan_ends_clear_of_the_walls_and_out_of_the_guard_band() {
+        // The same scene: a greedy run along the walls, polished. Frames that turn less end in the band
+        // unless put back under it, and put back they turn more, into the walls unless polished again
+        // (without that polish the plan that turns less ends 0.45 units into them).
+        let g = generate(11, 28, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
+        let scene = g.scene;
+        let (sim, bound, base) = planning_inputs(&scene);
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let run = &base.clean[0].trace;
+        let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
+        let fl = planner.fl;
+        let margin = settings.margin_units;
+        let plan = planner.warm_start(run);
+        let plans = polished(&mut planner, plan, margin);
+        assert_eq!(plans.len(), 2, "no frame turned less");
+        let strictly_in_band = |controls: &[FrameControl]| {
+            let states = rollout(&planner.start, controls, &fl);
+            std::iter::once(&planner.start)
+                .chain(&states)
+                .zip(controls)
+                .filter(|(x, u)| {
+                    fl.guard_band(x.speed)
+                        .is_some_and(|(guard, top)| u.c > guard + 1e-9 && u.c < top - 1e-9)
+                })
+                .count()
+        };
+        let turned = &plans[0];
+        let states = rollout(&planner.start, turned, &fl);
+        let violation = planner.problem(margin, false, 1).violation(&states);
+        assert!(
+            violation <= CLEAN_VIOLATION_UNITS,
+            "{violation} units into the walls"
+        );
+        assert_eq!(strictly_in_band(turned), 0);
+    }
+
+    #[test]
     fn roundings_polished_side_by_side_are_those_polished_one_after_the_other() {
         let scene = staircase_scene(2);
         let (sim, bound, base) = planning_inputs(&scene);
