@@ -324,10 +324,10 @@ pub(super) enum StartKind {
     /// A line already planned frame by frame (the relaxed stage's, or the final plan): refined at its
     /// frame count and below; it is itself a point of the certificate's problem.
     Planned,
-    /// A greedy run: coarse to fine, as the relaxed stage, but over knots from 200 frames
-    /// ([`CoarseRuns::AlsoShort`]), and never over more frames than the run's own: a start whose line
-    /// cannot be reached in the frames its run took is far from the optimum, and growing its count (three
-    /// stages over more frames each) only spends the solve's time.
+    /// A greedy run: coarse to fine, as the relaxed stage, but as [`Descent::GREEDY_START`] says: over
+    /// knots from 200 frames, and never over more frames than the run's own (a start whose line cannot be
+    /// reached in the frames its run took is far from the optimum, and growing its count, three stages
+    /// over more frames each, only spends the solve's time).
     Greedy,
 }
 
