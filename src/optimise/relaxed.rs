@@ -496,10 +496,26 @@ mod tests {
                 counts.push(frames);
             }
         };
-        certifier.add_start(&mut planner, &mut record, half, StartKind::Greedy, 0);
+        certifier.add_start(
+            &mut planner,
+            &mut record,
+            half.clone(),
+            StartKind::Greedy,
+            0,
+        );
         assert!(!counts.is_empty());
         assert!(counts.iter().all(|&c| c <= n), "{counts:?} against {n}");
         assert!(certifier.certificate().is_none(), "{counts:?}");
+        // The relaxed plan's search from the same start grows the count it cannot reach the line in.
+        let mut grown = Vec::new();
+        let mut record = |p: Progress| {
+            if let Progress::FrameCount { frames, .. } = p {
+                grown.push(frames);
+            }
+        };
+        let search = CountSearch::per_frame(Relaxation::certificate());
+        count_search(&mut planner, &mut record, half, n, 0, search);
+        assert!(grown.iter().any(|&c| c > n), "{grown:?} against {n}");
     }
 
     #[test]
