@@ -274,10 +274,15 @@ mod tests {
     }
 
     /// Frames of `controls` whose `c` lies inside the guard's band at their own speed, by more than
-    /// [`BAND_TOL_SHARE`] of its width.
-    fn in_the_band(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw) -> Vec<usize> {
+    /// `tol_share` of its width.
+    fn in_the_band(
+        start: &ModelState,
+        controls: &[FrameControl],
+        fl: &FrameLaw,
+        tol_share: f64,
+    ) -> Vec<usize> {
         let inside = |(u, (guard, top)): (&FrameControl, (f64, f64))| {
-            let tol = BAND_TOL_SHARE * (top - guard);
+            let tol = tol_share * (top - guard);
             u.c > guard + tol && u.c < top - tol
         };
         controls
@@ -289,103 +294,105 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn frames_that_turn_less_keep_to_their_side_of_the_guard_band() {
-        // Generated scene 28 of seed 11: 250 fps, air acceleration 10 (the law's first case, where the
-        // maximum-acceleration frame sits on the kink and plans keep half an anglemod step under it).
+    /// Runs `test` with a `fast` planner of generated scene 28 of seed 11 (250 fps, air acceleration 10:
+    /// the law's first case, where the maximum-acceleration frame sits on the kink and plans keep half an
+    /// anglemod step under it) and the warm start of its first clean greedy run, which runs along the
+    /// walls.
+    fn on_the_kink_guard_scene(test: impl FnOnce(&mut Planner, Vec<FrameControl>)) {
         let g = generate(11, 28, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
         let scene = g.scene;
         let (sim, bound, base) = planning_inputs(&scene);
         let settings = SearchSettings::for_quality(Quality::Fast);
         let run = &base.clean[0].trace;
         let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
-        let fl = planner.fl;
-        assert!(fl.has_kink_guard());
-        // The greedy run's sides out of the band, every fifth frame turning less, just above it.
-        let mut x = planner.start;
-        let mut plan = planner.warm_start(run);
-        for (k, u) in plan.iter_mut().enumerate() {
-            if let Some((_, top)) = fl.guard_band(x.speed) {
-                u.c = if k % 5 == 0 {
-                    top + 0.01
-                } else {
-                    fl.under_the_guard(u.c, x.speed)
-                };
+        assert!(planner.fl.has_kink_guard());
+        let warm = planner.warm_start(run);
+        test(&mut planner, warm);
+    }
+
+    #[test]
+    fn frames_that_turn_less_keep_to_their_side_of_the_guard_band() {
+        on_the_kink_guard_scene(|planner, warm| {
+            let fl = planner.fl;
+            let margin = planner.settings.margin_units;
+            // The greedy run's sides out of the band, every fifth frame turning less, just above it.
+            let mut x = planner.start;
+            let mut plan = warm;
+            for (k, u) in plan.iter_mut().enumerate() {
+                if let Some((_, top)) = fl.guard_band(x.speed) {
+                    u.c = if k % 5 == 0 {
+                        top + 0.01
+                    } else {
+                        fl.under_the_guard(u.c, x.speed)
+                    };
+                }
+                x = frame(&x, *u, &fl, false).0;
             }
-            x = frame(&x, *u, &fl, false).0;
-        }
-        assert_eq!(in_the_band(&planner.start, &plan, &fl), Vec::<usize>::new());
-        // A stage that may turn less and keeps to the band's sides: frames above it (every fifth) stay
-        // above, the others under it.
-        let pr = ScpProblem {
-            turn_less: true,
-            ..planner.problem(settings.margin_units, false, 1)
-        };
-        let kept = planner.stage(pr, plan.clone(), 5).0;
-        assert_ne!(kept, plan, "the stage did not move");
-        assert_eq!(in_the_band(&planner.start, &kept, &fl), Vec::<usize>::new());
-        for (k, (u, (guard, top))) in kept
-            .iter()
-            .zip(bands(&planner.start, &kept, &fl))
-            .enumerate()
-        {
-            let tol = BAND_TOL_SHARE * (top - guard);
-            let side_ok = if k % 5 == 0 {
-                u.c >= top - tol
-            } else {
-                u.c <= guard + tol
-            };
-            assert!(
-                side_ok,
-                "frame {k}: c {} against the band ({guard}, {top})",
-                u.c
+            assert_eq!(
+                in_the_band(&planner.start, &plan, &fl, BAND_TOL_SHARE),
+                Vec::<usize>::new()
             );
-        }
-        // Free of the band, the same stage moves frames into it.
-        let pr = ScpProblem {
-            turn_less: true,
-            anglemod_guard: false,
-            ..planner.problem(settings.margin_units, false, 1)
-        };
-        let free = planner.stage(pr, plan, 5).0;
-        assert!(!in_the_band(&planner.start, &free, &fl).is_empty());
+            // A stage that may turn less and keeps to the band's sides: frames above it (every fifth) stay
+            // above, the others under it.
+            let pr = ScpProblem {
+                turn_less: true,
+                ..planner.problem(margin, false, 1)
+            };
+            let kept = planner.stage(pr, plan.clone(), 5).0;
+            assert_ne!(kept, plan, "the stage did not move");
+            assert_eq!(
+                in_the_band(&planner.start, &kept, &fl, BAND_TOL_SHARE),
+                Vec::<usize>::new()
+            );
+            for (k, (u, (guard, top))) in kept
+                .iter()
+                .zip(bands(&planner.start, &kept, &fl))
+                .enumerate()
+            {
+                let tol = BAND_TOL_SHARE * (top - guard);
+                let side_ok = if k % 5 == 0 {
+                    u.c >= top - tol
+                } else {
+                    u.c <= guard + tol
+                };
+                assert!(
+                    side_ok,
+                    "frame {k}: c {} against the band ({guard}, {top})",
+                    u.c
+                );
+            }
+            // Free of the band, the same stage moves frames into it.
+            let pr = ScpProblem {
+                turn_less: true,
+                anglemod_guard: false,
+                ..planner.problem(margin, false, 1)
+            };
+            let free = planner.stage(pr, plan, 5).0;
+            assert!(!in_the_band(&planner.start, &free, &fl, BAND_TOL_SHARE).is_empty());
+        });
     }
 
     #[test]
     fn a_polished_plan_ends_clear_of_the_walls_and_out_of_the_guard_band() {
-        // The same scene: a greedy run along the walls, polished. Frames that turn less end in the band
-        // unless put back under it, and put back they turn more, into the walls unless polished again
-        // (without that polish the plan that turns less ends 0.45 units into them).
-        let g = generate(11, 28, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
-        let scene = g.scene;
-        let (sim, bound, base) = planning_inputs(&scene);
-        let settings = SearchSettings::for_quality(Quality::Fast);
-        let run = &base.clean[0].trace;
-        let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
-        let fl = planner.fl;
-        let margin = settings.margin_units;
-        let plan = planner.warm_start(run);
-        let plans = polished(&mut planner, plan, margin);
-        assert_eq!(plans.len(), 2, "no frame turned less");
-        let strictly_in_band = |controls: &[FrameControl]| {
-            let states = rollout(&planner.start, controls, &fl);
-            std::iter::once(&planner.start)
-                .chain(&states)
-                .zip(controls)
-                .filter(|(x, u)| {
-                    fl.guard_band(x.speed)
-                        .is_some_and(|(guard, top)| u.c > guard + 1e-9 && u.c < top - 1e-9)
-                })
-                .count()
-        };
-        let turned = &plans[0];
-        let states = rollout(&planner.start, turned, &fl);
-        let violation = planner.problem(margin, false, 1).violation(&states);
-        assert!(
-            violation <= CLEAN_VIOLATION_UNITS,
-            "{violation} units into the walls"
-        );
-        assert_eq!(strictly_in_band(turned), 0);
+        // Polished, frames that turn less end in the band unless put back under it, and put back they
+        // turn more, into the walls unless polished again (without that polish the plan that turns less
+        // ends 0.45 units into them).
+        on_the_kink_guard_scene(|planner, warm| {
+            let (fl, margin) = (planner.fl, planner.settings.margin_units);
+            let plans = polished(planner, warm, margin);
+            assert_eq!(plans.len(), 2, "no frame turned less");
+            let turned = &plans[0];
+            let states = rollout(&planner.start, turned, &fl);
+            let violation = planner.problem(margin, false, 1).violation(&states);
+            assert!(
+                violation <= CLEAN_VIOLATION_UNITS,
+                "{violation} units into the walls"
+            );
+            assert_eq!(
+                in_the_band(&planner.start, turned, &fl, 0.0),
+                Vec::<usize>::new()
+            );
+        });
     }
 
     #[test]

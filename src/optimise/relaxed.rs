@@ -63,6 +63,15 @@ impl Descent {
         coarse: CoarseRuns::AlsoShort,
         grow_tries: 0,
     };
+
+    /// The count search of this descent over `relaxation`, in steps of `frames_per_knot` frames.
+    pub(super) fn count_search(self, relaxation: Relaxation, frames_per_knot: u32) -> CountSearch {
+        CountSearch {
+            relaxation,
+            frames_per_knot,
+            grow_tries: self.grow_tries,
+        }
+    }
 }
 
 /// One search over frame counts: the relaxed problem, the planning step and how many times an unreachable
@@ -78,13 +87,9 @@ pub(super) struct CountSearch {
 }
 
 impl CountSearch {
-    /// Frame by frame, as the relaxed plan's search: an unreachable count grown [`MAX_GROW_TRIES`] times.
+    /// Frame by frame, as the relaxed plan's search ([`Descent::PLAN`]).
     pub(super) fn per_frame(relaxation: Relaxation) -> Self {
-        CountSearch {
-            relaxation,
-            frames_per_knot: 1,
-            grow_tries: MAX_GROW_TRIES,
-        }
+        Descent::PLAN.count_search(relaxation, 1)
     }
 }
 
@@ -171,14 +176,13 @@ pub(super) fn relaxed_plan(
             knots,
             count,
             lo / m,
-            CountSearch {
-                relaxation: Relaxation {
+            descent.count_search(
+                Relaxation {
                     margin_units: relaxation.margin_units + sagitta,
                     ..relaxation
                 },
-                frames_per_knot: knot_frames,
-                grow_tries: descent.grow_tries,
-            },
+                knot_frames,
+            ),
         ) {
             controls = plan
                 .iter()
@@ -187,10 +191,7 @@ pub(super) fn relaxed_plan(
             n = controls.len();
         }
     }
-    let per_frame = CountSearch {
-        grow_tries: descent.grow_tries,
-        ..CountSearch::per_frame(relaxation)
-    };
+    let per_frame = descent.count_search(relaxation, 1);
     count_search(planner, progress, controls, n, lo, per_frame)
 }
 
@@ -478,6 +479,17 @@ mod tests {
         assert_eq!((c.starts, c.reached), (6, 4));
     }
 
+    /// The frame counts a search reports (through `search`'s progress callback) as it tries them.
+    fn counts_tried(search: impl FnOnce(&mut dyn FnMut(Progress))) -> Vec<usize> {
+        let mut counts = Vec::new();
+        search(&mut |p| {
+            if let Progress::FrameCount { frames, .. } = p {
+                counts.push(frames);
+            }
+        });
+        counts
+    }
+
     #[test]
     fn a_greedy_start_of_the_certificate_is_never_solved_over_more_frames_than_its_run() {
         // The first half of a one-corner staircase's greedy seed: the line is out of its reach.
@@ -489,32 +501,18 @@ mod tests {
         let warm = planner.warm_start(base.seed());
         let half = warm[..warm.len() / 2].to_vec();
         let n = half.len();
-        let mut counts = Vec::new();
         let mut certifier = Certifier::default();
-        let mut record = |p: Progress| {
-            if let Progress::FrameCount { frames, .. } = p {
-                counts.push(frames);
-            }
-        };
-        certifier.add_start(
-            &mut planner,
-            &mut record,
-            half.clone(),
-            StartKind::Greedy,
-            0,
-        );
+        let counts = counts_tried(|record| {
+            certifier.add_start(&mut planner, record, half.clone(), StartKind::Greedy, 0);
+        });
         assert!(!counts.is_empty());
         assert!(counts.iter().all(|&c| c <= n), "{counts:?} against {n}");
         assert!(certifier.certificate().is_none(), "{counts:?}");
         // The relaxed plan's search from the same start grows the count it cannot reach the line in.
-        let mut grown = Vec::new();
-        let mut record = |p: Progress| {
-            if let Progress::FrameCount { frames, .. } = p {
-                grown.push(frames);
-            }
-        };
         let search = CountSearch::per_frame(Relaxation::certificate());
-        count_search(&mut planner, &mut record, half, n, 0, search);
+        let grown = counts_tried(|record| {
+            count_search(&mut planner, record, half, n, 0, search);
+        });
         assert!(grown.iter().any(|&c| c > n), "{grown:?} against {n}");
     }
 
