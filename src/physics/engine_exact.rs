@@ -46,23 +46,20 @@ pub fn engine_wish(control: &Control) -> Wish<f32> {
 /// The planning yaw (radians) that anglemod leaves unchanged and that is nearest to `yaw_rad`: planning on
 /// these yaws makes the plan and the game see the same view direction (up to `f32` rounding).
 pub fn quantise_yaw_rad(yaw_rad: f64) -> f64 {
-    let step = ANGLEMOD_STEP_DEG;
-    let deg = yaw_rad.to_degrees();
-    // Round to the nearest step, then nudge half a step's millionth up so the f32 truncation lands on it.
-    let k = (deg / step).round();
-    ((k + 1e-6) * step).to_radians()
+    yaw_on_step_rad((yaw_rad.to_degrees() / ANGLEMOD_STEP_DEG).round())
 }
 
 /// The two yaws on anglemod steps either side of `yaw_rad` (equal when it is on a step), each surviving
 /// anglemod unchanged: a planner picks between them to steer the game's quantised view.
 pub fn anglemod_bracket(yaw_rad: f64) -> (f64, f64) {
-    let step = ANGLEMOD_STEP_DEG;
-    let k = yaw_rad.to_degrees() / step;
-    let (lo, hi) = (k.floor(), k.ceil());
-    (
-        ((lo + 1e-6) * step).to_radians(),
-        ((hi + 1e-6) * step).to_radians(),
-    )
+    let k = yaw_rad.to_degrees() / ANGLEMOD_STEP_DEG;
+    (yaw_on_step_rad(k.floor()), yaw_on_step_rad(k.ceil()))
+}
+
+/// The yaw of anglemod step `k` (a whole number), radians, nudged a millionth of a step up so that the
+/// game's `f32` truncation lands on the step and not the one below.
+fn yaw_on_step_rad(k: f64) -> f64 {
+    ((k + 1e-6) * ANGLEMOD_STEP_DEG).to_radians()
 }
 
 /// An `f64` state rounded to the game's `f32`.
