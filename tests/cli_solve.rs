@@ -48,7 +48,7 @@ fn json_carries_every_documented_key() {
     assert_eq!(v["feasible"], true);
     assert_eq!(v["engine_exact"]["feasible"], true);
     // The certificate, the rounding loss it gives and the greedy guide that won.
-    for k in ["frames", "time", "starts", "reached", "spread"] {
+    for k in ["frames", "time", "starts", "reached", "short", "spread"] {
         assert!(v["relaxed"].get(k).is_some(), "missing relaxed.{k}");
     }
     let (plan, relaxed) = (

@@ -31,7 +31,7 @@ fn solved(scene: &Scene, quality: Quality) -> (Outcome, Crossing) {
         );
         assert!(r.time <= plan.time + 1e-9, "{r:?} after the plan {plan:?}");
         assert!(
-            r.reached >= 1 && r.reached <= r.starts && r.spread >= 0.0,
+            r.reached >= 1 && r.reached <= r.starts && r.short <= r.reached && r.spread >= 0.0,
             "{r:?}"
         );
         let tau = scene.frame_time_s();

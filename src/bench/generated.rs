@@ -57,8 +57,10 @@ pub struct SceneRecord {
     pub relaxed_frames: Option<u64>,
     /// The relaxed certificate's crossing time, game seconds.
     pub relaxed_time_s: Option<f64>,
-    /// The spread of the certificate's optimum over its starts, seconds.
+    /// The spread of the certificate's optimum over its starts that ended at their local optimum, seconds.
     pub relaxed_spread_s: Option<f64>,
+    /// The certificate's starts that reached the line but stopped short of their local optimum.
+    pub relaxed_short_starts: Option<usize>,
     /// The plan's time less the relaxed optimum's, frames, for a valid plan.
     pub rounding_loss_frames: Option<f64>,
     /// The greedy guide that gave the baseline.
@@ -94,6 +96,7 @@ impl SceneRecord {
             relaxed_frames: None,
             relaxed_time_s: None,
             relaxed_spread_s: None,
+            relaxed_short_starts: None,
             rounding_loss_frames: None,
             greedy_guide: String::new(),
             status: String::new(),
@@ -150,6 +153,7 @@ pub fn measure_generated_scene(
         r.relaxed_frames = Some(c.frames);
         r.relaxed_time_s = Some(c.time);
         r.relaxed_spread_s = Some(c.spread);
+        r.relaxed_short_starts = Some(c.short);
         if r.valid {
             let tau = g.scene.frame_time_s();
             r.rounding_loss_frames = r.time_s.map(|t| (t - c.time) / tau);
@@ -212,6 +216,10 @@ pub fn columns() -> Vec<Column> {
         Column {
             name: "relaxed spread over starts (ms)",
             value: |r| r.relaxed_spread_s.map(|s| 1000.0 * s),
+        },
+        Column {
+            name: "starts short of their optimum",
+            value: |r| r.relaxed_short_starts.map(|k| k as f64),
         },
         Column {
             name: "solve time per frame (ms)",
@@ -322,6 +330,7 @@ mod tests {
             relaxed_frames: None,
             relaxed_time_s: None,
             relaxed_spread_s: None,
+            relaxed_short_starts: None,
             rounding_loss_frames: None,
             greedy_guide: String::new(),
             status: String::new(),

@@ -271,11 +271,18 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         format!("{:>10.6} s (frame {})", lb.time, lb.frames),
     ));
     if let Some(r) = o.relaxed {
+        let spread = match r.short {
+            0 => format!("spread {:.6} s", r.spread),
+            k => format!(
+                "{k} still improving when stopped; spread of the others {:.6} s",
+                r.spread
+            ),
+        };
         s.push_str(&field(
             "relaxed optimum",
             format!(
-                "{:>10.6} s (frame {}; a local optimum: {} of {} starts reached the line, spread {:.6} s)",
-                r.time, r.frames, r.reached, r.starts, r.spread
+                "{:>10.6} s (frame {}; a local optimum: {} of {} starts reached the line, {spread})",
+                r.time, r.frames, r.reached, r.starts
             ),
         ));
     }

@@ -111,7 +111,7 @@ pub(super) fn plan_airborne(
     if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
         let (controls, n) = (plan.controls.clone(), plan.controls.len());
         let search = CountSearch::per_frame(Relaxation::planning(margins.planning));
-        if let Some(line) = count_search(planner, progress, controls, n, lo, search) {
+        if let Some(line) = count_search(planner, progress, controls, n, lo, search).line {
             let source = Source {
                 line,
                 margin: margins.planning,
@@ -186,7 +186,8 @@ fn lines_and_plans(
         lo,
         Relaxation::planning(margins.planning),
         Descent::PLAN,
-    )?;
+    )
+    .line?;
     let start = relaxed.clone();
     let certify = move |fork: &mut Planner| {
         let mut certifier = Certifier::default();
@@ -217,7 +218,7 @@ fn exact_plans_of_both_lines(
     if let Some(tight) = margins.tight {
         let n = relaxed.len();
         let search = CountSearch::per_frame(Relaxation::planning(tight));
-        if let Some(line) = count_search(planner, progress, relaxed, n, lo, search) {
+        if let Some(line) = count_search(planner, progress, relaxed, n, lo, search).line {
             sources.push(Source {
                 line,
                 margin: tight,

@@ -15,7 +15,8 @@ use crate::sim::Crossing;
 /// Times, in one count search, a relaxed stage that stopped at its iteration cap without a clean crossing
 /// is continued at its count before that count is given up: the budget is the whole search's, not each
 /// count's, so a start far from the line whose stages keep ending inside the margin stops at the count it
-/// has reached, short of its optimum (the certificate's spread then counts it as it stands).
+/// has reached, short of its optimum ([`Descended::short`]: the certificate counts its line for the fastest,
+/// not for the spread).
 const MAX_CONTINUED_STAGES: usize = 3;
 
 /// About this many knots make the coarse stage of a long run (the planning steps of a 100 fps run of four
@@ -142,7 +143,7 @@ pub(super) fn coarse_knot_frames(frames: usize, runs: CoarseRuns) -> u32 {
 
 /// The relaxed plan at wall `margin` (units) from the warm start `controls`, whose line crossing is near
 /// frame `n`; no plan crosses before frame `lo` (the lower bound's). Coarse to fine on the `descent`'s
-/// coarse runs. Returns the best clean plan, cut at its crossing frame.
+/// coarse runs. Returns the search over frames: its best clean plan, cut at its crossing frame.
 pub(super) fn relaxed_plan(
     planner: &mut Planner,
     progress: &mut dyn FnMut(Progress),
@@ -151,7 +152,7 @@ pub(super) fn relaxed_plan(
     lo: usize,
     relaxation: Relaxation,
     descent: Descent,
-) -> Option<Vec<FrameControl>> {
+) -> Descended {
     let knot_frames = coarse_knot_frames(n, descent.coarse);
     if knot_frames > 1 {
         let m = knot_frames as usize;
@@ -183,7 +184,9 @@ pub(super) fn relaxed_plan(
                 },
                 knot_frames,
             ),
-        ) {
+        )
+        .line
+        {
             controls = plan
                 .iter()
                 .flat_map(|u| std::iter::repeat_n(*u, m))
@@ -195,10 +198,21 @@ pub(super) fn relaxed_plan(
     count_search(planner, progress, controls, n, lo, per_frame)
 }
 
+/// What a count search ends with.
+pub(super) struct Descended {
+    /// The best clean line, cut at its crossing step.
+    pub(super) line: Option<Vec<FrameControl>>,
+    /// Whether the search stopped before it found that one step fewer than its line cannot reach the
+    /// finish line (nor stopped at the bound's count): the stages at a count it could not yet reach ran
+    /// out of continuations while still improving, or the budget ran out. Its line is then not the local
+    /// optimum of its start.
+    pub(super) short: bool,
+}
+
 /// The search over the number of planning steps (frames or knots, as `search` says): SCP at `n` steps
 /// from `controls`, then at one step fewer than the plan's crossing, until the line is no longer reached
 /// (or `lo` steps, below which the bound says it cannot be); more steps if the first count does not reach
-/// it (at most `search.grow_tries` times). Returns the best clean plan, cut at its crossing step.
+/// it (at most `search.grow_tries` times).
 pub(super) fn count_search<'a>(
     planner: &mut Planner<'a>,
     progress: &mut dyn FnMut(Progress),
@@ -206,7 +220,7 @@ pub(super) fn count_search<'a>(
     mut n: usize,
     lo: usize,
     search: CountSearch,
-) -> Option<Vec<FrameControl>> {
+) -> Descended {
     let CountSearch {
         relaxation,
         frames_per_knot,
@@ -218,10 +232,10 @@ pub(super) fn count_search<'a>(
     let mut best: Option<Vec<FrameControl>> = None;
     let mut grow_tries = 0;
     let mut continue_tries = 0;
-    loop {
+    let short = loop {
         if planner.out_of_time() {
             planner.note_cut(Stage::Relaxed);
-            break;
+            break true;
         }
         controls.resize(
             n,
@@ -249,7 +263,7 @@ pub(super) fn count_search<'a>(
                 // improving the same line (stepping further on a failed probe proves nothing, the
                 // search being local).
                 if k <= lo + 1 || planner.timed_out {
-                    break;
+                    break planner.timed_out;
                 }
                 n = k - 1;
                 controls = c[..n].to_vec();
@@ -261,8 +275,10 @@ pub(super) fn count_search<'a>(
                 controls = c;
             }
             _ => {
+                // With a line in hand the count below it is unreachable from it, unless the stage was
+                // still improving when its continuations ran out.
                 if best.is_some() || grow_tries >= max_grow_tries || planner.timed_out {
-                    break;
+                    break capped || planner.timed_out;
                 }
                 // Not reachable at this count from this start: give it more steps.
                 grow_tries += 1;
@@ -270,8 +286,8 @@ pub(super) fn count_search<'a>(
                 controls = c;
             }
         }
-    }
-    best
+    };
+    Descended { line: best, short }
 }
 
 /// The SCP problem of `relaxation` over planning steps of `frames_per_knot` frames.
@@ -300,7 +316,11 @@ pub struct RelaxedCertificate {
     pub starts: usize,
     /// Starts whose relaxed plan reached the line.
     pub reached: usize,
-    /// The slowest less the fastest crossing time over the starts that reached the line, seconds.
+    /// Of those, starts whose search stopped short of its local optimum, still improving when its
+    /// stages ran out (or when the time limit came): their lines count towards the fastest, not the spread.
+    pub short: usize,
+    /// The slowest less the fastest crossing time over the starts that reached the line at their local
+    /// optimum (and the fastest, wherever it came from), seconds.
     pub spread: f64,
 }
 
@@ -315,8 +335,18 @@ pub(super) struct CertifiedPlan {
 #[derive(Default)]
 pub(super) struct Certifier {
     tried: usize,
-    times: Vec<f64>,
+    /// Per start that reached the line, in order.
+    ends: Vec<StartEnd>,
     best: Option<CertifiedPlan>,
+}
+
+/// Where a start of the certificate ended.
+#[derive(Clone, Copy, Debug)]
+struct StartEnd {
+    /// Its line's crossing time, seconds.
+    time: f64,
+    /// Whether its search stopped short of its local optimum ([`Descended::short`]).
+    short: bool,
 }
 
 /// How a start of the certificate is solved.
@@ -354,7 +384,7 @@ impl Certifier {
             StartKind::Greedy => None,
         };
         let relaxation = Relaxation::certificate();
-        let solved = match kind {
+        let descended = match kind {
             StartKind::Planned => {
                 let search = CountSearch::per_frame(relaxation);
                 count_search(planner, progress, start, n, lo, search)
@@ -363,8 +393,11 @@ impl Certifier {
                 let descent = Descent::GREEDY_START;
                 relaxed_plan(planner, progress, start, n, lo, relaxation, descent)
             }
-        }
-        .and_then(|p| planner.crossing_of(&p).map(|c| (c, p)));
+        };
+        let short = descended.short;
+        let solved = descended
+            .line
+            .and_then(|p| planner.crossing_of(&p).map(|c| (c, p)));
         let reached = match (solved, own) {
             (Some(s), Some(o)) => Some(if o.0.time < s.0.time { o } else { s }),
             (s, o) => s.or(o),
@@ -372,7 +405,10 @@ impl Certifier {
         let Some((crossing, controls)) = reached else {
             return;
         };
-        self.times.push(crossing.time);
+        self.ends.push(StartEnd {
+            time: crossing.time,
+            short,
+        });
         if self
             .best
             .as_ref()
@@ -391,7 +427,7 @@ impl Certifier {
     pub(super) fn absorb(&mut self, other: Certifier) {
         let offset = self.tried;
         self.tried += other.tried;
-        self.times.extend(other.times);
+        self.ends.extend(other.ends);
         if let Some(plan) = other.best {
             if self
                 .best
@@ -419,12 +455,16 @@ impl Certifier {
     /// The certificate, if any start reached the line.
     pub(super) fn certificate(&self) -> Option<RelaxedCertificate> {
         let best = self.best.as_ref()?;
-        let slowest = self.times.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let at_optimum = self.ends.iter().filter(|e| !e.short);
+        let slowest = at_optimum
+            .map(|e| e.time)
+            .fold(best.crossing.time, f64::max);
         Some(RelaxedCertificate {
             frames: best.crossing.frames,
             time: best.crossing.time,
             starts: self.tried,
-            reached: self.times.len(),
+            reached: self.ends.len(),
+            short: self.ends.iter().filter(|e| e.short).count(),
             spread: slowest - best.crossing.time,
         })
     }
@@ -445,7 +485,13 @@ mod tests {
         let fastest = fractions.iter().copied().fold(f64::INFINITY, f64::min);
         Certifier {
             tried,
-            times: fractions.iter().map(|&f| crossing(f).time).collect(),
+            ends: fractions
+                .iter()
+                .map(|&f| StartEnd {
+                    time: crossing(f).time,
+                    short: false,
+                })
+                .collect(),
             best: Some(CertifiedPlan {
                 controls: Vec::new(),
                 start_index: best_index,
@@ -477,6 +523,77 @@ mod tests {
             .certificate()
             .unwrap_or_else(|| panic!("no certificate"));
         assert_eq!((c.starts, c.reached), (6, 4));
+    }
+
+    #[test]
+    fn a_start_stopped_short_of_its_optimum_counts_for_the_fastest_but_not_the_spread() {
+        // Frame 100 at 100 fps: starts at 0.2 (short), 0.5 and 0.9 through it, the short one fastest.
+        let crossing = |f: f64| Crossing::new(100, f, 0.01);
+        let end = |f: f64, short: bool| StartEnd {
+            time: crossing(f).time,
+            short,
+        };
+        let certifier = Certifier {
+            tried: 4,
+            ends: vec![end(0.5, false), end(0.2, true), end(0.9, false)],
+            best: Some(CertifiedPlan {
+                controls: Vec::new(),
+                start_index: 1,
+                crossing: crossing(0.2),
+            }),
+        };
+        let c = certifier
+            .certificate()
+            .unwrap_or_else(|| panic!("no certificate"));
+        assert_eq!((c.starts, c.reached, c.short), (4, 3, 1));
+        assert!((c.time - crossing(0.2).time).abs() < 1e-12, "{c:?}");
+        // The slowest start at its optimum less the fastest: 0.9 - 0.2 of a frame.
+        assert!((c.spread - 0.007).abs() < 1e-12, "{c:?}");
+        // A slow start stopped short widens nothing: only the fastest at its optimum then counts.
+        let alone = Certifier {
+            tried: 2,
+            ends: vec![end(0.5, false), end(0.9, true)],
+            best: Some(CertifiedPlan {
+                controls: Vec::new(),
+                start_index: 0,
+                crossing: crossing(0.5),
+            }),
+        };
+        let c = alone
+            .certificate()
+            .unwrap_or_else(|| panic!("no certificate"));
+        assert_eq!((c.reached, c.short), (2, 1));
+        assert!(c.spread.abs() < 1e-12, "{c:?}");
+    }
+
+    #[test]
+    fn a_count_search_whose_stages_run_out_still_improving_says_it_stopped_short() {
+        // The one-corner staircase from its greedy seed, to the certificate's problem: with two SCP
+        // iterations a count every stage ends at its cap, and the search stops while still improving;
+        // with the settings' own cap it ends where one frame fewer cannot reach the line.
+        let scene = staircase_scene(1);
+        let (sim, bound, base) = planning_inputs(&scene);
+        let search = CountSearch::per_frame(Relaxation::certificate());
+        let mut ends = Vec::new();
+        for relaxed_iters in [2, SearchSettings::for_quality(Quality::Fast).relaxed_iters] {
+            let settings = SearchSettings {
+                relaxed_iters,
+                ..SearchSettings::for_quality(Quality::Fast)
+            };
+            let budget = Budget::unlimited();
+            let mut planner = Planner::new(&scene, &sim, &settings, &bound, base.seed(), budget);
+            let warm = planner.warm_start(base.seed());
+            let n = warm.len();
+            let d = count_search(&mut planner, &mut |_| {}, warm, n, 0, search);
+            let frames = d.line.as_ref().map(Vec::len);
+            ends.push((frames, d.short));
+        }
+        let [(capped_frames, capped_short), (full_frames, full_short)] = ends[..] else {
+            panic!("{ends:?}");
+        };
+        assert!(capped_short && !full_short, "{ends:?}");
+        assert!(capped_frames.is_some() && full_frames.is_some(), "{ends:?}");
+        assert!(full_frames <= capped_frames, "{ends:?}");
     }
 
     /// The frame counts a search reports (through `search`'s progress callback) as it tries them.
