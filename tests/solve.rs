@@ -294,6 +294,24 @@ fn a_rounding_that_misses_the_relaxed_frame_at_one_horizon_is_found_at_another()
 }
 
 #[test]
+fn a_faster_line_found_from_the_plan_is_rounded_too() {
+    // Generated scene 27 of seed 81 (CI-sized family: 100 fps, air acceleration 100): the plan rounded
+    // from the relaxed line crosses in frame 97, faster than every start of the certificate; started
+    // from that plan, the certificate's problem finds a line of 96 frames, and that line, refined and
+    // rounded in turn, gives a plan of 96.
+    let g = strafeopt::scene::generate::generate(
+        81,
+        27,
+        &strafeopt::scene::generate::GeneratorSettings::ci_sized(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let (o, plan) = solved(&g.scene, Quality::Fast);
+    let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
+    assert_eq!((plan.frames, r.frames), (96, 96), "{plan:?} against {r:?}");
+    assert!(o.trace.feasible() && o.engine_exact.feasible());
+}
+
+#[test]
 fn a_line_refined_at_the_tight_margin_reaches_the_certificate_frame() {
     // Generated scene 12 of seed 71 (CI-sized family: 100 fps, air acceleration 100, 270 ups into one
     // turn of the 182-unit corridor): rounded from the line planned 3.2 units off the walls (room for a

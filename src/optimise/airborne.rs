@@ -106,34 +106,66 @@ pub(super) fn plan_airborne(
     for side_certifier in side_certifiers {
         certifier.absorb(side_certifier);
     }
-    // A greedy start whose relaxed line is faster than the relaxed plan's: its line, refined at the
-    // planning margin, is rounded too.
+    // A greedy start whose relaxed line is faster than the relaxed plan's: its line is rounded too.
     if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
-        let (controls, n) = (plan.controls.clone(), plan.controls.len());
-        let search = CountSearch::per_frame(Relaxation::planning(margins.planning));
-        if let Some(line) = count_search(planner, progress, controls, n, lo, search).line {
-            let source = Source {
-                line,
-                margin: margins.planning,
-                planning: true,
-            };
-            exact_plans(planner, &source, greedy_s, &mut best);
-        }
+        let line = plan.controls.clone();
+        plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, &mut best);
     }
-    // The final plan is a point of the certificate's problem too: where it is faster than the certificate
-    // (the relaxed stage stopped short of its optimum), it is the last start, so that the certificate is
-    // never behind the plan. The start is the plan as played, not its planned controls: a plan whose
-    // controls end before the line is played on at maximum acceleration until it crosses.
-    let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
-    if let Some((_, trace)) = best.as_ref().filter(|b| behind(b.0)) {
-        let start = planner.warm_start(trace);
-        certifier.add_start(planner, progress, start, StartKind::Planned, lo);
+    // Descending from the plan, the certificate's problem can find a faster line than the relaxed stage
+    // did (it stopped short of its optimum, or in a slower basin): that line is rounded too, and the plan
+    // that comes of it is a start again, so that the certificate stays no slower than the plan.
+    if let Some(line) = plan_as_certificate_start(planner, &mut certifier, &best, lo, progress) {
+        plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, &mut best);
+        plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
     }
     AirbornePlan {
         best,
         certifier,
         relaxed_found: true,
     }
+}
+
+/// The exact plans of a line of the certificate's problem faster than the relaxed plan's: the line is
+/// refined at the planning margin, then rounded, polished and verified; a faster plan replaces `best`.
+fn plans_of_certificate_line(
+    planner: &mut Planner,
+    line: Vec<FrameControl>,
+    lo: usize,
+    margins: LineMargins,
+    greedy_s: f64,
+    progress: &mut dyn FnMut(Progress),
+    best: &mut BestPlan,
+) {
+    let n = line.len();
+    let search = CountSearch::per_frame(Relaxation::planning(margins.planning));
+    if let Some(line) = count_search(planner, progress, line, n, lo, search).line {
+        let source = Source {
+            line,
+            margin: margins.planning,
+            planning: true,
+        };
+        exact_plans(planner, &source, greedy_s, best);
+    }
+}
+
+/// The final plan is a point of the certificate's problem too: where it is faster than the certificate,
+/// it becomes the certificate's last start. The start is the plan as played, not its planned controls: a
+/// plan whose controls end before the line is played on at maximum acceleration until it crosses. Returns
+/// the line solved from that start when it is the certificate's fastest (and so faster than the plan).
+fn plan_as_certificate_start(
+    planner: &mut Planner,
+    certifier: &mut Certifier,
+    best: &BestPlan,
+    lo: usize,
+    progress: &mut dyn FnMut(Progress),
+) -> Option<Vec<FrameControl>> {
+    let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
+    let (_, trace) = best.as_ref().filter(|b| behind(b.0))?;
+    let start = planner.warm_start(trace);
+    let solved_fastest = certifier.add_start(planner, progress, start, StartKind::Planned, lo);
+    solved_fastest
+        .then(|| certifier.best().map(|p| p.controls.clone()))
+        .flatten()
 }
 
 /// The warm starts of the certificate's greedy starts: the other clean greedy runs (not from a start at

@@ -364,7 +364,8 @@ pub(super) enum StartKind {
 
 impl Certifier {
     /// Solves the certificate's problem from `start` (planning controls cut near their crossing); no plan
-    /// crosses before frame `lo`. Does nothing once time is up.
+    /// crosses before frame `lo`. Does nothing once time is up. Returns whether the line solved from the
+    /// start (not a planned start's own) is now the fastest.
     pub(super) fn add_start(
         &mut self,
         planner: &mut Planner,
@@ -372,9 +373,9 @@ impl Certifier {
         start: Vec<FrameControl>,
         kind: StartKind,
         lo: usize,
-    ) {
+    ) -> bool {
         if planner.out_of_time() {
-            return;
+            return false;
         }
         let index = self.tried;
         self.tried += 1;
@@ -398,28 +399,30 @@ impl Certifier {
         let solved = descended
             .line
             .and_then(|p| planner.crossing_of(&p).map(|c| (c, p)));
-        let reached = match (solved, own) {
-            (Some(s), Some(o)) => Some(if o.0.time < s.0.time { o } else { s }),
-            (s, o) => s.or(o),
+        let (reached, solved_won) = match (solved, own) {
+            (Some(s), Some(o)) if o.0.time < s.0.time => (Some(o), false),
+            (Some(s), _) => (Some(s), true),
+            (None, o) => (o, false),
         };
         let Some((crossing, controls)) = reached else {
-            return;
+            return false;
         };
         self.ends.push(StartEnd {
             time: crossing.time,
             short,
         });
-        if self
+        let fastest = self
             .best
             .as_ref()
-            .is_none_or(|b| crossing.time < b.crossing.time)
-        {
+            .is_none_or(|b| crossing.time < b.crossing.time);
+        if fastest {
             self.best = Some(CertifiedPlan {
                 controls,
                 start_index: index,
                 crossing,
             });
         }
+        fastest && solved_won
     }
 
     /// Takes in the starts of `other`, solved apart (on another thread), as the starts after this one's:
