@@ -299,16 +299,8 @@ fn a_faster_line_found_from_the_plan_is_rounded_too() {
     // from the relaxed line crosses in frame 97, faster than every start of the certificate; started
     // from that plan, the certificate's problem finds a line of 96 frames, and that line, refined and
     // rounded in turn, gives a plan of 96.
-    let g = strafeopt::scene::generate::generate(
-        81,
-        27,
-        &strafeopt::scene::generate::GeneratorSettings::ci_sized(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let (o, plan) = solved(&g.scene, Quality::Fast);
-    let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
+    let (plan, r) = ci_sized_plan_and_certificate(81, 27);
     assert_eq!((plan.frames, r.frames), (96, 96), "{plan:?} against {r:?}");
-    assert!(o.trace.feasible() && o.engine_exact.feasible());
 }
 
 #[test]
@@ -318,18 +310,25 @@ fn a_line_refined_at_the_tight_margin_reaches_the_certificate_frame() {
     // braking frame's push, `tau gamma1`), the plan crossed in frame 310, a frame behind its certificate;
     // the line refined at the tight margin (`tau L`, twice the swing of alternating sides) reaches
     // frame 309.
-    let g = strafeopt::scene::generate::generate(
-        71,
-        12,
-        &strafeopt::scene::generate::GeneratorSettings::ci_sized(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let (o, plan) = solved(&g.scene, Quality::Fast);
-    let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
+    let (plan, r) = ci_sized_plan_and_certificate(71, 12);
     assert_eq!(
         (plan.frames, r.frames),
         (309, 309),
         "{plan:?} against {r:?}"
     );
+}
+
+/// Scene `index` of `seed` of the CI-sized generated family solved at `fast`: the plan's crossing and
+/// the certificate, once the plan is checked valid in f64 and engine-exact.
+fn ci_sized_plan_and_certificate(
+    seed: u64,
+    index: u64,
+) -> (Crossing, strafeopt::optimise::RelaxedCertificate) {
+    let settings = strafeopt::scene::generate::GeneratorSettings::ci_sized();
+    let g = strafeopt::scene::generate::generate(seed, index, &settings)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let (o, plan) = solved(&g.scene, Quality::Fast);
     assert!(o.trace.feasible() && o.engine_exact.feasible());
+    let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
+    (plan, r)
 }

@@ -481,18 +481,24 @@ mod tests {
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
 
-    /// A certifier that tried `tried` starts, reached the line at `times` (frame 100 at 100 fps, as a
+    /// A certifier that tried `tried` starts, reached the line at `fractions` (frame 100 at 100 fps, as a
     /// fraction through it), the fastest from start `best_index`.
     fn certifier_of(tried: usize, fractions: &[f64], best_index: usize) -> Certifier {
+        let ends: Vec<(f64, bool)> = fractions.iter().map(|&f| (f, false)).collect();
+        certifier_ending(tried, &ends, best_index)
+    }
+
+    /// As [`certifier_of`], each start's fraction with whether its search stopped short.
+    fn certifier_ending(tried: usize, ends: &[(f64, bool)], best_index: usize) -> Certifier {
         let crossing = |f: f64| Crossing::new(100, f, 0.01);
-        let fastest = fractions.iter().copied().fold(f64::INFINITY, f64::min);
+        let fastest = ends.iter().map(|e| e.0).fold(f64::INFINITY, f64::min);
         Certifier {
             tried,
-            ends: fractions
+            ends: ends
                 .iter()
-                .map(|&f| StartEnd {
+                .map(|&(f, short)| StartEnd {
                     time: crossing(f).time,
-                    short: false,
+                    short,
                 })
                 .collect(),
             best: Some(CertifiedPlan {
@@ -530,39 +536,19 @@ mod tests {
 
     #[test]
     fn a_start_stopped_short_of_its_optimum_counts_for_the_fastest_but_not_the_spread() {
-        // Frame 100 at 100 fps: starts at 0.2 (short), 0.5 and 0.9 through it, the short one fastest.
-        let crossing = |f: f64| Crossing::new(100, f, 0.01);
-        let end = |f: f64, short: bool| StartEnd {
-            time: crossing(f).time,
-            short,
-        };
-        let certifier = Certifier {
-            tried: 4,
-            ends: vec![end(0.5, false), end(0.2, true), end(0.9, false)],
-            best: Some(CertifiedPlan {
-                controls: Vec::new(),
-                start_index: 1,
-                crossing: crossing(0.2),
-            }),
-        };
-        let c = certifier
+        // Starts at 0.5, 0.2 (short, the fastest) and 0.9 through frame 100 at 100 fps; one more tried.
+        let c = certifier_ending(4, &[(0.5, false), (0.2, true), (0.9, false)], 1)
             .certificate()
             .unwrap_or_else(|| panic!("no certificate"));
         assert_eq!((c.starts, c.reached, c.short), (4, 3, 1));
-        assert!((c.time - crossing(0.2).time).abs() < 1e-12, "{c:?}");
+        assert!(
+            (c.time - Crossing::new(100, 0.2, 0.01).time).abs() < 1e-12,
+            "{c:?}"
+        );
         // The slowest start at its optimum less the fastest: 0.9 - 0.2 of a frame.
         assert!((c.spread - 0.007).abs() < 1e-12, "{c:?}");
         // A slow start stopped short widens nothing: only the fastest at its optimum then counts.
-        let alone = Certifier {
-            tried: 2,
-            ends: vec![end(0.5, false), end(0.9, true)],
-            best: Some(CertifiedPlan {
-                controls: Vec::new(),
-                start_index: 0,
-                crossing: crossing(0.5),
-            }),
-        };
-        let c = alone
+        let c = certifier_ending(2, &[(0.5, false), (0.9, true)], 0)
             .certificate()
             .unwrap_or_else(|| panic!("no certificate"));
         assert_eq!((c.reached, c.short), (2, 1));
