@@ -136,16 +136,29 @@ fn plans_of_certificate_line(
     progress: &mut dyn FnMut(Progress),
     best: &mut BestPlan,
 ) {
-    let n = line.len();
-    let search = CountSearch::per_frame(Relaxation::planning(margins.planning));
-    if let Some(line) = count_search(planner, progress, line, n, lo, search).line {
-        let source = Source {
-            line,
-            margin: margins.planning,
-            planning: true,
-        };
+    if let Some(source) = refined(planner, progress, line, lo, margins.planning, true) {
         exact_plans(planner, &source, greedy_s, best);
     }
+}
+
+/// `line` refined by the count search at `margin` (units), frame by frame, as a line to round (`planning`:
+/// whether it is at the planning margin, see [`Source::planning`]); `None` if it no longer reaches the line.
+fn refined(
+    planner: &mut Planner,
+    progress: &mut dyn FnMut(Progress),
+    line: Vec<FrameControl>,
+    lo: usize,
+    margin: f64,
+    planning: bool,
+) -> Option<Source> {
+    let n = line.len();
+    let search = CountSearch::per_frame(Relaxation::planning(margin));
+    let line = count_search(planner, progress, line, n, lo, search).line?;
+    Some(Source {
+        line,
+        margin,
+        planning,
+    })
 }
 
 /// The final plan is a point of the certificate's problem too: where it is faster than the certificate,
@@ -162,10 +175,10 @@ fn plan_as_certificate_start(
     let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
     let (_, trace) = best.as_ref().filter(|b| behind(b.0))?;
     let start = planner.warm_start(trace);
-    let solved_fastest = certifier.add_start(planner, progress, start, StartKind::Planned, lo);
-    solved_fastest
-        .then(|| certifier.best().map(|p| p.controls.clone()))
-        .flatten()
+    if !certifier.add_start(planner, progress, start, StartKind::Planned, lo) {
+        return None;
+    }
+    certifier.best().map(|p| p.controls.clone())
 }
 
 /// The warm starts of the certificate's greedy starts: the other clean greedy runs (not from a start at
@@ -248,15 +261,7 @@ fn exact_plans_of_both_lines(
         planning: true,
     }];
     if let Some(tight) = margins.tight {
-        let n = relaxed.len();
-        let search = CountSearch::per_frame(Relaxation::planning(tight));
-        if let Some(line) = count_search(planner, progress, relaxed, n, lo, search).line {
-            sources.push(Source {
-                line,
-                margin: tight,
-                planning: false,
-            });
-        }
+        sources.extend(refined(planner, progress, relaxed, lo, tight, false));
     }
     progress(Progress::Finishing);
     let mut best = None;
