@@ -296,6 +296,20 @@ fn a_faster_line_found_from_the_plan_is_rounded_too() {
 }
 
 #[test]
+fn a_rejected_step_whose_wall_rows_are_corrected_keeps_the_descent_going() {
+    // Generated scene 10 of seed 11 (CI-sized family: 100 fps, air acceleration 10): without the
+    // second-order correction of rejected steps the count search's steps land in the walls (the model's
+    // second-order error along them), the trust region shrinks, and plan and certificate both stop at
+    // frame 102; with it both reach 101.
+    let (plan, r) = ci_sized_plan_and_certificate(11, 10);
+    assert_eq!(
+        (plan.frames, r.frames),
+        (101, 101),
+        "{plan:?} against {r:?}"
+    );
+}
+
+#[test]
 fn a_line_refined_at_the_tight_margin_reaches_the_certificate_frame() {
     // Generated scene 12 of seed 71 (CI-sized family: 100 fps, air acceleration 100, 270 ups into one
     // turn of the 182-unit corridor): rounded from the line planned 3.2 units off the walls (room for a

@@ -63,6 +63,9 @@ pub struct SubProblem<'a> {
     /// Per frame `k`, the convexified Hessian of the Lagrangian in `(V_{k-1}, psi_{k-1}, sigma_k, c_k)`
     /// ([`super::lagrangian`]); `None`: a linear model (the first iteration, before any duals).
     pub curvature: Option<&'a [CurvatureBlock]>,
+    /// Per frame, a correction added to the position in its wall rows: a second-order correction's
+    /// estimate of what the linearised dynamics leave out ([`super::scp`]); `None`: none.
+    pub wall_shift: Option<&'a [crate::physics::Vec2]>,
 }
 
 /// How a sub-problem ended, mapped from Clarabel's status in one place.
@@ -85,6 +88,8 @@ pub struct SubStep {
     pub status: SubStepStatus,
     /// Per frame `(d sigma, d c)` (c in ups), when solved.
     pub du: Vec<(f64, f64)>,
+    /// Per frame, the model's change of the end position, units, when solved.
+    pub dp: Vec<crate::physics::Vec2>,
     /// The model's predicted decrease of the merit (progress minus weighted violation), when solved.
     pub predicted: f64,
     /// Per frame, the duals `z` of its dynamics rows `(px, py, V, psi)` (Clarabel's convention
@@ -101,6 +106,7 @@ impl SubStep {
         SubStep {
             status,
             du: vec![],
+            dp: vec![],
             predicted: 0.0,
             dynamics_duals: vec![],
         }
@@ -214,7 +220,11 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     let n_eq = row;
     // Walls: -n . dp_k - s_j <= n . p_k - offset - margin.
     for (j, w) in sp.walls.iter().enumerate() {
-        let p = sp.positions[w.frame];
+        let shift = sp
+            .wall_shift
+            .and_then(|e| e.get(w.frame).copied())
+            .unwrap_or_default();
+        let p = sp.positions[w.frame] + shift;
         ri.extend([row, row, row]);
         ci.extend([ix(w.frame, 0), ix(w.frame, 1), is(row_slack[j])]);
         vals.extend([-w.plane.normal.x, -w.plane.normal.y, -1.0]);
@@ -349,6 +359,9 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
             (change(0), change(1) * C_SCALE_UPS)
         })
         .collect();
+    let dp = (0..n)
+        .map(|k| crate::physics::Vec2::new(x[ix(k, 0)], x[ix(k, 1)]))
+        .collect();
     let progress_gain = if n > 0 {
         sp.progress_dir.x * x[ix(n - 1, 0)] + sp.progress_dir.y * x[ix(n - 1, 1)]
     } else {
@@ -387,6 +400,7 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     SubStep {
         status,
         du,
+        dp,
         predicted,
         dynamics_duals,
     }
@@ -443,6 +457,7 @@ mod tests {
             sigma_range: ranges,
             c_range: ranges,
             curvature: None,
+            wall_shift: None,
         }
     }
 
@@ -489,6 +504,34 @@ mod tests {
         // 2 per ups of frame 0's c, 3 per unit of frame 1's side.
         assert!((r.predicted - (2.0 + 1.5)).abs() < 1e-5, "{}", r.predicted);
         assert_eq!(r.dynamics_duals.len(), 2);
+    }
+
+    #[test]
+    fn a_wall_shift_moves_the_wall_rows_by_what_the_model_leaves_out() {
+        // The side moves the end position up and along, one unit each; the wall keeps it at y <= 0.5.
+        // Unshifted, the side rises until the wall binds (0.5); with 0.2 units of y the model leaves out,
+        // only to 0.3. The step's position change is reported either way.
+        let mut a = [[0.0; 4]; 4];
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] = 1.0;
+        }
+        let jac = FrameJacobian {
+            a,
+            b: [[1.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
+        };
+        let (j, p, w) = one_frame(jac, 0.5);
+        let ranges = [(1.0, 1.0)];
+        let plain = solve(&sub(&j, &p, &w, &ranges));
+        let left_out = [Vec2::new(0.0, 0.2)];
+        let shifted = solve(&SubProblem {
+            wall_shift: Some(&left_out),
+            ..sub(&j, &p, &w, &ranges)
+        });
+        for (r, side) in [(&plain, 0.5), (&shifted, 0.3)] {
+            assert_eq!(r.status, SubStepStatus::Solved { almost: false });
+            assert!((r.du[0].0 - side).abs() < 1e-6, "{:?}", r.du);
+            assert!((r.dp[0].y - side).abs() < 1e-6, "{:?}", r.dp);
+        }
     }
 
     #[test]

@@ -48,6 +48,14 @@ pub struct ScpProblem<'a> {
     pub(super) turn_less: bool,
 }
 
+/// One iteration's linearisation with the trust region's ranges: everything its sub-problems need.
+struct Linearisation {
+    lin: Linearised,
+    positions: Vec<Vec2>,
+    sigma_range: Vec<(f64, f64)>,
+    c_range: Vec<(f64, f64)>,
+}
+
 /// The trajectory of a parameter vector with what the sub-problem needs.
 struct Linearised {
     states: Vec<ModelState>,
@@ -149,6 +157,99 @@ impl ScpProblem<'_> {
         }
     }
 
+    /// The trajectory of `controls` linearised, with each frame's trust-region ranges: `sigma` within
+    /// `trust * sigma_trust`, `c` within `trust * c_trust_ups` (ups) and its bounds. With `duals` (one per
+    /// frame, from the last sub-problem), the curvature of the Lagrangian too.
+    fn linearisation(
+        &self,
+        controls: &[FrameControl],
+        duals: Option<&[[f64; 4]]>,
+        (trust, sigma_trust, c_trust): (f64, f64, f64),
+        upper_at_kink: bool,
+    ) -> Linearisation {
+        // Each frame stays on its piece of mu = min(gamma1, L - c) within a step, so the linearisation
+        // is exact to first order; a frame on the kink tries the upper piece (mu = L - c) on even
+        // iterations and the lower (mu = gamma1) on odd ones.
+        let kink = self.fl.kink();
+        let at_kink = |c: f64| (c - kink).abs() <= KINK_TOL_UPS;
+        let lin_controls: Vec<FrameControl> = controls
+            .iter()
+            .map(|u| {
+                if at_kink(u.c) {
+                    let c = if upper_at_kink {
+                        kink + KINK_TOL_UPS
+                    } else {
+                        kink - KINK_TOL_UPS
+                    };
+                    FrameControl { c, ..*u }
+                } else {
+                    *u
+                }
+            })
+            .collect();
+        let lin = self.linearise(&lin_controls, duals);
+        let mut sigma_range = Vec::with_capacity(controls.len());
+        let mut c_range = Vec::with_capacity(controls.len());
+        let mut speed = self.start.speed;
+        for (k, u) in lin_controls.iter().enumerate() {
+            let ds = trust * sigma_trust;
+            sigma_range.push(if self.relaxed {
+                (ds.min(1.0 + u.sigma), ds.min(1.0 - u.sigma))
+            } else {
+                (0.0, 0.0)
+            });
+            let dc = trust * c_trust;
+            let (mut lo, mut hi) = (
+                dc.min(u.c - self.c_min(speed)).max(0.0),
+                dc.min(self.c_upper(speed) - u.c).max(0.0),
+            );
+            if u.c > kink {
+                lo = lo.min(u.c - kink);
+            } else {
+                hi = hi.min(kink - u.c);
+            }
+            // A frame keeps to its side of the guard's band: above the kink no lower than the band's
+            // top, else no higher than its bottom (one the speed's change put inside moves out only).
+            if let Some((guard, top)) = self.guard_band_kept(speed) {
+                if u.c > kink {
+                    lo = lo.min((u.c - top).max(0.0));
+                } else {
+                    hi = hi.min((guard - u.c).max(0.0));
+                }
+            }
+            c_range.push((lo, hi));
+            speed = lin.states[k].speed;
+        }
+        let positions: Vec<Vec2> = lin.states.iter().map(|s| s.pos).collect();
+        Linearisation {
+            lin,
+            positions,
+            sigma_range,
+            c_range,
+        }
+    }
+
+    /// The sub-problem around `lz`, its wall rows moved by `wall_shift` (see [`SubProblem::wall_shift`]).
+    fn sub_problem<'s>(
+        &self,
+        lz: &'s Linearisation,
+        wall_shift: Option<&'s [Vec2]>,
+    ) -> SubProblem<'s> {
+        SubProblem {
+            jacobians: &lz.lin.jacobians,
+            positions: &lz.positions,
+            walls: &lz.lin.walls,
+            margin: self.margin,
+            accepted_clearance: MERIT_MARGIN_SHARE * self.margin,
+            slack_weight: self.slack_weight,
+            progress_dir: self.progress_dir,
+            sigma_range: &lz.sigma_range,
+            c_range: &lz.c_range,
+            curvature: lz.lin.curvature.as_deref(),
+            wall_shift,
+        }
+    }
+
     /// Highest `c` allowed at speed `v`, ups: [`FrameLaw::c_exact_max`] for exact sides that may turn
     /// less; else [`FrameLaw::c_max`], under the anglemod guard when it is on.
     fn c_upper(&self, v: f64) -> f64 {
@@ -228,6 +329,15 @@ impl<'c> ScpSolver<'c> {
     }
 }
 
+/// The parameters of `controls` moved by `du` (`(d sigma, d c)` per frame), each side kept in `[-1, 1]`.
+fn stepped(controls: &[FrameControl], du: &[(f64, f64)]) -> Vec<f64> {
+    controls
+        .iter()
+        .zip(du)
+        .flat_map(|(u, d)| [(u.sigma + d.0).clamp(-1.0, 1.0), u.c + d.1])
+        .collect()
+}
+
 /// Total wall violation, units, up to which a plan counts as clear (rounding of the clearance sums).
 pub(super) const CLEAN_VIOLATION_UNITS: f64 = 1e-9;
 
@@ -272,81 +382,21 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
             .ok_or_else(|| ArgminError::msg("no plan"))?;
         let cost = state.get_cost();
         let controls = unpack(&param);
-        let (trust, sigma_trust, c_trust) = (self.trust, self.sigma_trust, self.c_trust_ups);
+        let trust = (self.trust, self.sigma_trust, self.c_trust_ups);
         let upper_at_kink = state.get_iter() % 2 == 0;
         let duals = self.duals.take();
         let seconds_left = self
             .budget
             .remaining()
             .map_or(f64::INFINITY, |d| d.as_secs_f64());
-        let step = problem.problem("linearise-and-solve", |pr| {
-            // Each frame stays on its piece of mu = min(gamma1, L - c) within a step, so the linearisation
-            // is exact to first order; a frame on the kink tries the upper piece (mu = L - c) on even
-            // iterations and the lower (mu = gamma1) on odd ones.
-            let kink = pr.fl.kink();
-            let at_kink = |c: f64| (c - kink).abs() <= KINK_TOL_UPS;
-            let lin_controls: Vec<FrameControl> = controls
-                .iter()
-                .map(|u| {
-                    if at_kink(u.c) {
-                        let c = if upper_at_kink {
-                            kink + KINK_TOL_UPS
-                        } else {
-                            kink - KINK_TOL_UPS
-                        };
-                        FrameControl { c, ..*u }
-                    } else {
-                        *u
-                    }
-                })
-                .collect();
-            let lin = pr.linearise(&lin_controls, duals.as_deref());
-            let mut sigma_range = Vec::with_capacity(controls.len());
-            let mut c_range = Vec::with_capacity(controls.len());
-            let mut speed = pr.start.speed;
-            for (k, u) in lin_controls.iter().enumerate() {
-                let ds = trust * sigma_trust;
-                sigma_range.push(if pr.relaxed {
-                    (ds.min(1.0 + u.sigma), ds.min(1.0 - u.sigma))
-                } else {
-                    (0.0, 0.0)
-                });
-                let dc = trust * c_trust;
-                let (mut lo, mut hi) = (
-                    dc.min(u.c - pr.c_min(speed)).max(0.0),
-                    dc.min(pr.c_upper(speed) - u.c).max(0.0),
-                );
-                if u.c > kink {
-                    lo = lo.min(u.c - kink);
-                } else {
-                    hi = hi.min(kink - u.c);
-                }
-                // A frame keeps to its side of the guard's band: above the kink no lower than the band's
-                // top, else no higher than its bottom (one the speed's change put inside moves out only).
-                if let Some((guard, top)) = pr.guard_band_kept(speed) {
-                    if u.c > kink {
-                        lo = lo.min((u.c - top).max(0.0));
-                    } else {
-                        hi = hi.min((guard - u.c).max(0.0));
-                    }
-                }
-                c_range.push((lo, hi));
-                speed = lin.states[k].speed;
-            }
-            let positions: Vec<Vec2> = lin.states.iter().map(|s| s.pos).collect();
-            let sub = SubProblem {
-                jacobians: &lin.jacobians,
-                positions: &positions,
-                walls: &lin.walls,
-                margin: pr.margin,
-                accepted_clearance: MERIT_MARGIN_SHARE * pr.margin,
-                slack_weight: pr.slack_weight,
-                progress_dir: pr.progress_dir,
-                sigma_range: &sigma_range,
-                c_range: &c_range,
-                curvature: lin.curvature.as_deref(),
-            };
-            Ok(qp::solve_within_time(&sub, seconds_left))
+        let lz = problem.problem("linearise", |pr| {
+            Ok(pr.linearisation(&controls, duals.as_deref(), trust, upper_at_kink))
+        })?;
+        let step = problem.problem("solve", |pr| {
+            Ok(qp::solve_within_time(
+                &pr.sub_problem(&lz, None),
+                seconds_left,
+            ))
         })?;
         self.stats.iterations += 1;
         self.stats.subproblems += 1;
@@ -368,11 +418,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
             self.converged = true;
             return Ok((state, None));
         }
-        let candidate: Vec<f64> = controls
-            .iter()
-            .zip(&du)
-            .flat_map(|(u, d)| [(u.sigma + d.0).clamp(-1.0, 1.0), u.c + d.1])
-            .collect();
+        let candidate = stepped(&controls, &du);
         // A plan whose trajectory is not finite is simply worse than any finite one.
         let new_cost = problem.cost(&candidate).unwrap_or(f64::INFINITY);
         let actual = cost - new_cost;
@@ -385,6 +431,20 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
             }
             Ok((state.param(candidate).cost(new_cost), None))
         } else {
+            if let Some((corrected, corrected_cost)) = self.second_order_correction(
+                problem,
+                &lz,
+                &controls,
+                &candidate,
+                &step.dp,
+                seconds_left,
+            )? {
+                // Delivered enough of the first step's prediction: kept, the trust region as it was.
+                if cost - corrected_cost >= ACCEPT_RATIO * step.predicted {
+                    self.stats.corrected_steps += 1;
+                    return Ok((state.param(corrected).cost(corrected_cost), None));
+                }
+            }
             self.stats.rejected_steps += 1;
             self.trust *= 0.3;
             Ok((state, None))
@@ -410,6 +470,53 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
 }
 
 impl ScpSolver<'_> {
+    /// The second-order correction of a rejected step (Nocedal and Wright, section 18.3): the linearised
+    /// dynamics leave out the second-order change of the positions, which along hundreds of frames adds up
+    /// to units, so a step that the sub-problem kept clear can land in a wall, and the merit charges that
+    /// at the slack weight. The sub-problem is solved again about the same linearisation with each frame's
+    /// wall rows moved by what the model left out of the trial's position (`candidate` played, less the
+    /// model's position after the step, `step_dp` being its change), and the corrected plan and its cost
+    /// come back.
+    fn second_order_correction(
+        &mut self,
+        problem: &mut Problem<ScpProblem<'_>>,
+        lz: &Linearisation,
+        controls: &[FrameControl],
+        candidate: &[f64],
+        step_dp: &[Vec2],
+        seconds_left: f64,
+    ) -> std::result::Result<Option<(Vec<f64>, f64)>, ArgminError> {
+        let corrected = problem.problem("correct", |pr| {
+            let trial = rollout_knots(&pr.start, &unpack(candidate), &pr.fl, pr.frames_per_knot);
+            // A step that came no closer to the walls failed on the model's progress, which moving the
+            // wall rows does not mend.
+            if pr.violation(&trial) <= pr.violation(&lz.lin.states) {
+                return Ok(None);
+            }
+            let left_out: Vec<Vec2> = trial
+                .iter()
+                .zip(&lz.positions)
+                .zip(step_dp)
+                .map(|((t, p), dp)| t.pos - (*p + *dp))
+                .collect();
+            Ok(Some(qp::solve_within_time(
+                &pr.sub_problem(lz, Some(&left_out)),
+                seconds_left,
+            )))
+        })?;
+        let Some(corrected) = corrected else {
+            return Ok(None);
+        };
+        self.stats.subproblems += 1;
+        if !matches!(corrected.status, SubStepStatus::Solved { .. }) {
+            return Ok(None);
+        }
+        let corrected = stepped(controls, &corrected.du);
+        // A plan whose trajectory is not finite is simply worse than any finite one.
+        let corrected_cost = problem.cost(&corrected).unwrap_or(f64::INFINITY);
+        Ok(Some((corrected, corrected_cost)))
+    }
+
     /// Whether a plan short of the line (`cost > 0`: the merit is the progress past it) cannot reach it
     /// in the iterations the stage has left, at the pace of the last [`STALL_WINDOW`] iterations. The
     /// count search then gives the count up at once instead of spending the stage's cap proving it.

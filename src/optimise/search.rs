@@ -189,8 +189,11 @@ pub struct SearchStats {
     pub subproblems: u64,
     /// Sub-problems Clarabel could not solve (trust region shrunk).
     pub subproblem_failures: u64,
-    /// Steps rejected by exact re-simulation.
+    /// Steps rejected by exact re-simulation, their second-order correction too.
     pub rejected_steps: u64,
+    /// Steps rejected by exact re-simulation but kept after a second-order correction (each such
+    /// correction is one more sub-problem).
+    pub corrected_steps: u64,
     /// Frame counts tried.
     pub frame_counts_tried: u64,
 }
@@ -202,6 +205,7 @@ impl SearchStats {
         self.subproblems += other.subproblems;
         self.subproblem_failures += other.subproblem_failures;
         self.rejected_steps += other.rejected_steps;
+        self.corrected_steps += other.corrected_steps;
         self.frame_counts_tried += other.frame_counts_tried;
     }
 }

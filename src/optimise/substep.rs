@@ -141,6 +141,7 @@ impl SubStepSetup {
             sigma_range: &self.sigma_range,
             c_range: &self.c_range,
             curvature: None,
+            wall_shift: None,
         }
     }
 
