@@ -428,16 +428,23 @@ mod tests {
         (vec![jac], vec![Vec2::new(5.0, 0.0)], walls)
     }
 
-    fn jacobian(v: f64) -> FrameJacobian {
+    /// A frame that carries the state over unchanged and adds `b` times the control change.
+    fn carrying_over(b: [[f64; 2]; 4]) -> FrameJacobian {
         let mut a = [[0.0; 4]; 4];
         for (i, row) in a.iter_mut().enumerate() {
             row[i] = 1.0;
         }
+        FrameJacobian { a, b }
+    }
+
+    fn jacobian(v: f64) -> FrameJacobian {
         // d px / d c = v, d py / d sigma = v
-        FrameJacobian {
-            a,
-            b: [[0.0, v], [v, 0.0], [0.0, 0.0], [0.0, 0.0]],
-        }
+        carrying_over([[0.0, v], [v, 0.0], [0.0, 0.0], [0.0, 0.0]])
+    }
+
+    /// The side moves the end position up and along, one unit each.
+    fn side_moves_up_and_along() -> FrameJacobian {
+        carrying_over([[1.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]])
     }
 
     fn sub<'a>(
@@ -478,14 +485,7 @@ mod tests {
         // ups). Frame 0's side and frame 1's c have no room: they stay, and the others rise to their
         // bounds. A control mapped to the wrong variable would move, or gain another's progress.
         let jac = |b_sigma: f64, b_c: f64| {
-            let mut a = [[0.0; 4]; 4];
-            for (i, row) in a.iter_mut().enumerate() {
-                row[i] = 1.0;
-            }
-            FrameJacobian {
-                a,
-                b: [[b_sigma, b_c], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
-            }
+            carrying_over([[b_sigma, b_c], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]])
         };
         let j = [jac(1.0, 2.0), jac(3.0, 4.0)];
         let p = [Vec2::new(5.0, 0.0), Vec2::new(10.0, 0.0)];
@@ -511,14 +511,7 @@ mod tests {
         // The side moves the end position up and along, one unit each; the wall keeps it at y <= 0.5.
         // Unshifted, the side rises until the wall binds (0.5); with 0.2 units of y the model leaves out,
         // only to 0.3. The step's position change is reported either way.
-        let mut a = [[0.0; 4]; 4];
-        for (i, row) in a.iter_mut().enumerate() {
-            row[i] = 1.0;
-        }
-        let jac = FrameJacobian {
-            a,
-            b: [[1.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
-        };
+        let jac = side_moves_up_and_along();
         let (j, p, w) = one_frame(jac, 0.5);
         let ranges = [(1.0, 1.0)];
         let plain = solve(&sub(&j, &p, &w, &ranges));
@@ -564,14 +557,7 @@ mod tests {
         // Sigma moves the end position up and along: one unit of progress per unit of violation of two
         // walls of the same move, both out of reach. At a slack weight of 0.75 the step pays for the
         // violation once (0.75 < 1: sigma rises); paid per row (1.5 > 1) sigma would fall.
-        let mut a = [[0.0; 4]; 4];
-        for (i, row) in a.iter_mut().enumerate() {
-            row[i] = 1.0;
-        }
-        let jac = FrameJacobian {
-            a,
-            b: [[1.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
-        };
+        let jac = side_moves_up_and_along();
         let wall = |offset: f64, group: usize| WallRow {
             frame: 0,
             group,

@@ -51,7 +51,6 @@ pub struct ScpProblem<'a> {
 /// One iteration's linearisation with the trust region's ranges: everything its sub-problems need.
 struct Linearisation {
     lin: Linearised,
-    positions: Vec<Vec2>,
     sigma_range: Vec<(f64, f64)>,
     c_range: Vec<(f64, f64)>,
 }
@@ -59,6 +58,8 @@ struct Linearisation {
 /// The trajectory of a parameter vector with what the sub-problem needs.
 struct Linearised {
     states: Vec<ModelState>,
+    /// The states' positions, as the sub-problem takes them.
+    positions: Vec<Vec2>,
     jacobians: Vec<super::model::FrameJacobian>,
     walls: Vec<WallRow>,
     /// Per frame, the convexified Lagrangian block, when duals were given.
@@ -150,6 +151,7 @@ impl ScpProblem<'_> {
             prev = s.pos;
         }
         Linearised {
+            positions: states.iter().map(|s| s.pos).collect(),
             states,
             jacobians,
             walls,
@@ -157,14 +159,14 @@ impl ScpProblem<'_> {
         }
     }
 
-    /// The trajectory of `controls` linearised, with each frame's trust-region ranges: `sigma` within
-    /// `trust * sigma_trust`, `c` within `trust * c_trust_ups` (ups) and its bounds. With `duals` (one per
+    /// The trajectory of `controls` linearised, with each frame's trust-region ranges at radius `trust`:
+    /// `sigma` within `trust * SIGMA_TRUST`, `c` within `trust * C_TRUST_UPS` (ups) and its bounds. With `duals` (one per
     /// frame, from the last sub-problem), the curvature of the Lagrangian too.
     fn linearisation(
         &self,
         controls: &[FrameControl],
         duals: Option<&[[f64; 4]]>,
-        (trust, sigma_trust, c_trust): (f64, f64, f64),
+        trust: f64,
         upper_at_kink: bool,
     ) -> Linearisation {
         // Each frame stays on its piece of mu = min(gamma1, L - c) within a step, so the linearisation
@@ -192,13 +194,13 @@ impl ScpProblem<'_> {
         let mut c_range = Vec::with_capacity(controls.len());
         let mut speed = self.start.speed;
         for (k, u) in lin_controls.iter().enumerate() {
-            let ds = trust * sigma_trust;
+            let ds = trust * SIGMA_TRUST;
             sigma_range.push(if self.relaxed {
                 (ds.min(1.0 + u.sigma), ds.min(1.0 - u.sigma))
             } else {
                 (0.0, 0.0)
             });
-            let dc = trust * c_trust;
+            let dc = trust * C_TRUST_UPS;
             let (mut lo, mut hi) = (
                 dc.min(u.c - self.c_min(speed)).max(0.0),
                 dc.min(self.c_upper(speed) - u.c).max(0.0),
@@ -220,10 +222,8 @@ impl ScpProblem<'_> {
             c_range.push((lo, hi));
             speed = lin.states[k].speed;
         }
-        let positions: Vec<Vec2> = lin.states.iter().map(|s| s.pos).collect();
         Linearisation {
             lin,
-            positions,
             sigma_range,
             c_range,
         }
@@ -237,7 +237,7 @@ impl ScpProblem<'_> {
     ) -> SubProblem<'s> {
         SubProblem {
             jacobians: &lz.lin.jacobians,
-            positions: &lz.positions,
+            positions: &lz.lin.positions,
             walls: &lz.lin.walls,
             margin: self.margin,
             accepted_clearance: MERIT_MARGIN_SHARE * self.margin,
@@ -297,8 +297,6 @@ type ScpState = IterState<Vec<f64>, (), (), (), (), f64>;
 pub struct ScpSolver<'c> {
     budget: Budget<'c>,
     trust: f64,
-    sigma_trust: f64,
-    c_trust_ups: f64,
     min_trust: f64,
     tol: f64,
     converged: bool,
@@ -316,8 +314,6 @@ impl<'c> ScpSolver<'c> {
         ScpSolver {
             budget,
             trust: 1.0,
-            sigma_trust: 0.1,
-            c_trust_ups: 5.0,
             min_trust: 1e-7,
             tol,
             converged: false,
@@ -337,6 +333,12 @@ fn stepped(controls: &[FrameControl], du: &[(f64, f64)]) -> Vec<f64> {
         .flat_map(|(u, d)| [(u.sigma + d.0).clamp(-1.0, 1.0), u.c + d.1])
         .collect()
 }
+
+/// A step's change of each frame's side at trust radius 1.
+const SIGMA_TRUST: f64 = 0.1;
+
+/// A step's change of each frame's `c` at trust radius 1, ups.
+const C_TRUST_UPS: f64 = 5.0;
 
 /// Total wall violation, units, up to which a plan counts as clear (rounding of the clearance sums).
 pub(super) const CLEAN_VIOLATION_UNITS: f64 = 1e-9;
@@ -382,7 +384,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
             .ok_or_else(|| ArgminError::msg("no plan"))?;
         let cost = state.get_cost();
         let controls = unpack(&param);
-        let trust = (self.trust, self.sigma_trust, self.c_trust_ups);
+        let trust = self.trust;
         let upper_at_kink = state.get_iter() % 2 == 0;
         let duals = self.duals.take();
         let seconds_left = self
@@ -495,7 +497,7 @@ impl ScpSolver<'_> {
             }
             let left_out: Vec<Vec2> = trial
                 .iter()
-                .zip(&lz.positions)
+                .zip(&lz.lin.positions)
                 .zip(step_dp)
                 .map(|((t, p), dp)| t.pos - (*p + *dp))
                 .collect();
@@ -509,6 +511,7 @@ impl ScpSolver<'_> {
         };
         self.stats.subproblems += 1;
         if !matches!(corrected.status, SubStepStatus::Solved { .. }) {
+            self.stats.subproblem_failures += 1;
             return Ok(None);
         }
         let corrected = stepped(controls, &corrected.du);
