@@ -4,8 +4,9 @@
 //! The baseline is the strongest greedy strafer we know how to run: the look-ahead strafer (maximum
 //! acceleration every frame, docs/physics.md section 6, steering only by its side) along each of several
 //! guides: the corridor's shortest path kept 0 to 40 units off the walls and
-//! the centre line (the guide kept as far off the walls as the corridor allows), every look-ahead, then
-//! the same with speed caps from the radius-speed relation (section 9) on airborne scenes. The fastest
+//! the centre line (the guide kept as far off the walls as the corridor allows), every look-ahead, then on
+//! airborne scenes the same turning as sharply as its target needs (section 9: the frame that turns that
+//! far for the least speed), and with speed caps and corner speeds from the radius-speed relation. The fastest
 //! valid run whose engine-exact replay is valid too is the baseline (else the fastest valid run), and
 //! which guide gave it is reported. Scenes with ground movement (groundstrafing, jumping) run capped too,
 //! with caps that are shares of the groundstrafing top speed as well (section 12), but only when no
@@ -55,6 +56,9 @@ pub struct GreedyGuide {
     /// The width of the bends, units for the hull centre, whose arcs' speeds the strafer keeps under
     /// through each corner of its guide (and brakes for before it), if it does.
     pub corner_bend_units: Option<f64>,
+    /// Whether the strafer turns as sharply as its target needs (uncapped; see
+    /// [`Greedy::with_sharp_turns`]).
+    pub sharp_turns: bool,
 }
 
 impl std::fmt::Display for GreedyGuide {
@@ -78,6 +82,9 @@ impl std::fmt::Display for GreedyGuide {
         }
         if let Some(w) = self.corner_bend_units {
             write!(f, ", corner speeds of {w:.0}-unit bends")?;
+        }
+        if self.sharp_turns {
+            write!(f, ", turning as sharply as it needs")?;
         }
         Ok(())
     }
@@ -231,12 +238,14 @@ struct GuidePath {
     path: Vec<Vec2>,
 }
 
-/// How a greedy run keeps its speed down: a speed cap held once reached, or the corner speeds of bends of
-/// a width (units, for the hull centre).
+/// How a greedy run takes corners its maximum-acceleration turn cannot: keeping its speed down (a speed
+/// cap held once reached, or the corner speeds of bends of a width, units for the hull centre), or
+/// turning harder than maximum acceleration as its target needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum SpeedLimit {
     Cap(f64),
     CornerSpeeds(f64),
+    SharpTurns,
 }
 
 /// The guide paths of `scene`: the shortest path (the lower bound's) and the paths kept each of
@@ -322,7 +331,10 @@ pub(super) fn baseline(
         let corners = CAP_WIDTHS_UNITS
             .iter()
             .map(|&w| SpeedLimit::CornerSpeeds(w));
-        caps.chain(corners).collect()
+        std::iter::once(SpeedLimit::SharpTurns)
+            .chain(caps)
+            .chain(corners)
+            .collect()
     } else {
         Vec::new()
     };
@@ -391,6 +403,9 @@ fn strafer(path: &[Vec2], guide: &GreedyGuide, corners: Option<&CornerSpeeds>) -
     if let Some(speeds) = corners {
         g = g.with_corner_speeds(speeds.clone());
     }
+    if guide.sharp_turns {
+        g = g.with_sharp_turns();
+    }
     g
 }
 
@@ -423,16 +438,22 @@ fn sweep_guides(
 ) {
     let first = uncapped.then_some(None);
     'sweep: for limit in first.into_iter().chain(limits.iter().copied().map(Some)) {
-        let (cap, corner_bend_units) = match limit {
-            None => (None, None),
-            Some(SpeedLimit::Cap(cap)) => (Some(cap), None),
-            Some(SpeedLimit::CornerSpeeds(w)) => (None, Some(w)),
+        let (cap, corner_bend_units, sharp_turns) = match limit {
+            None => (None, None, false),
+            Some(SpeedLimit::Cap(cap)) => (Some(cap), None, false),
+            Some(SpeedLimit::CornerSpeeds(w)) => (None, Some(w), false),
+            Some(SpeedLimit::SharpTurns) => (None, None, true),
         };
-        // Limited runs along the shortest path and the widest guide only: the limits are for corners the
-        // uncapped strafer overshoots, and every guide in between would multiply the runs.
+        // Speed-limited runs along the shortest path and the widest guide only: the limits are for corners
+        // the uncapped strafer overshoots, and every guide in between would multiply the runs. Sharp turns
+        // keep the speed, so the guide they follow matters as much as the plain strafer's.
         let last = guides.len() - 1;
+        let limited = matches!(
+            limit,
+            Some(SpeedLimit::Cap(_) | SpeedLimit::CornerSpeeds(_))
+        );
         for (i, g) in guides.iter().enumerate() {
-            if limit.is_some() && i != 0 && i != last {
+            if limited && i != 0 && i != last {
                 continue;
             }
             // The corner speeds along this guide, the same at every look-ahead.
@@ -451,6 +472,7 @@ fn sweep_guides(
                     lookahead_units: la,
                     speed_cap_ups: cap,
                     corner_bend_units,
+                    sharp_turns,
                 };
                 let run = sim.run_summary_broken_until(
                     &mut strafer(&g.path, &guide, corners.as_ref()),
@@ -532,6 +554,7 @@ fn pick_greedy(
                 lookahead_units: GREEDY_LOOKAHEADS_UNITS[0],
                 speed_cap_ups: None,
                 corner_bend_units: None,
+                sharp_turns: false,
             };
             GuideRun {
                 guide,
@@ -626,15 +649,104 @@ mod tests {
         assert!((speeds.braking_ups_per_s - gamma1 * 100.0).abs() < 1e-9);
     }
 
+    /// The shipped hairpin (128-unit legs around a 64-unit divider) at air acceleration 100, entered at
+    /// 1200 ups.
+    fn fast_hairpin_at_air_acceleration_100() -> Scene {
+        let text = r#"
+name = "hairpin-aa100"
+[engine]
+preset = "goldsrc"
+fps = 100
+airaccelerate = 100
+effects = ["air-accel", "max-velocity", "walls"]
+[start]
+velocity = [1200, 0]
+on-ground = false
+[hairpin]
+width = 128
+length = 1200
+gap = 64
+finish = 1200
+kind = "rule"
+"#;
+        Scene::from_toml_str(text, "test").unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn at_air_acceleration_100_the_strafer_turning_sharply_takes_a_hairpin_at_speed() {
+        // Maximum acceleration turns about L / V = 30 / 1200 rad a frame, an arc of 480 units: the plain
+        // strafer must slow to about 540 ups for the hairpin's 96-unit arc. A frame pushing sideways
+        // harder (gamma1 = 320 ups) turns ten times as fast for a few ups.
+        let scene = fast_hairpin_at_air_acceleration_100();
+        let (sim, bound, base) = planning_inputs(&scene);
+        let guide = base.greedy.guide;
+        assert!(guide.sharp_turns, "{guide}");
+        assert!(base.greedy.trace.feasible(), "{guide}");
+        let frames = base.greedy.trace.crossing.map_or(u64::MAX, |c| c.frames);
+        let slowest = base
+            .greedy
+            .trace
+            .frames
+            .iter()
+            .map(|r| r.speed)
+            .fold(f64::INFINITY, f64::min);
+        // The best valid run of every other strafer.
+        let guides = guide_paths(&scene, &bound);
+        let limits: Vec<SpeedLimit> = corner_caps(&scene, &bound.path)
+            .into_iter()
+            .map(SpeedLimit::Cap)
+            .chain(
+                CAP_WIDTHS_UNITS
+                    .iter()
+                    .map(|&w| SpeedLimit::CornerSpeeds(w)),
+            )
+            .collect();
+        let mut runs = GuideRuns::default();
+        let limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames;
+        sweep_guides(
+            &sim,
+            &guides,
+            &limits,
+            true,
+            limit,
+            &Budget::unlimited(),
+            &mut runs,
+        );
+        let (other_s, _, other) = runs.valid[0];
+        // Measured: 200 frames, never under 1073 ups; the best other run 2.65 s (corner speeds).
+        assert!(slowest > 800.0, "{slowest} ups through the hairpin");
+        assert!(
+            (frames as f64) * scene.frame_time_s() < 0.85 * other_s,
+            "{frames} frames against {other_s} s ({other})"
+        );
+    }
+
     #[test]
     fn on_a_staircase_the_strafer_with_corner_speeds_beats_every_single_cap() {
         // One cap is the sharpest corner's speed held on every leg; corner speeds free the legs between.
         let scene = staircase_scene(5);
-        let (sim, bound, base) = planning_inputs(&scene);
-        let guide = base.greedy.guide;
+        let (sim, bound, _) = planning_inputs(&scene);
+        let guides = guide_paths(&scene, &bound);
+        let corner_speeds: Vec<SpeedLimit> = CAP_WIDTHS_UNITS
+            .iter()
+            .map(|&w| SpeedLimit::CornerSpeeds(w))
+            .collect();
+        let mut runs = GuideRuns::default();
+        let limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames;
+        let budget = Budget::unlimited();
+        sweep_guides(
+            &sim,
+            &guides,
+            &corner_speeds,
+            false,
+            limit,
+            &budget,
+            &mut runs,
+        );
+        let (best_s, _, guide) = runs.valid[0];
         assert!(guide.corner_bend_units.is_some(), "{guide}");
-        assert!(base.greedy.trace.feasible(), "{guide}");
-        let shortest = &guide_paths(&scene, &bound)[0].path;
+        let frames = (best_s / scene.frame_time_s()).ceil() as u64;
+        let shortest = &guides[0].path;
         let mut capped = u64::MAX;
         for cap in corner_caps(&scene, &bound.path) {
             for &la in &GREEDY_LOOKAHEADS_UNITS {
@@ -645,7 +757,6 @@ mod tests {
                 }
             }
         }
-        let frames = base.greedy.trace.crossing.map_or(u64::MAX, |c| c.frames);
         assert!(frames < capped, "{frames} against capped {capped}");
     }
 }

@@ -249,6 +249,45 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
     best
 }
 
+/// The turn of one frame at `cos theta`, radians (docs/physics.md section 9): `atan2(mu sin theta,
+/// lambda + mu cos theta)` with `theta` in `[0, pi]`.
+#[inline]
+pub fn turn_at(lambda: f64, cos_theta: f64, law: AccelLaw) -> f64 {
+    let c = cos_theta.clamp(-1.0, 1.0);
+    let s = (1.0 - c * c).max(0.0).sqrt();
+    let mu = mu_at(lambda, c, law);
+    (mu * s).atan2(lambda + mu * c)
+}
+
+/// Bisection steps of [`turning_cos_theta`]: the angle to about `pi / 2^40`.
+const TURN_BISECTIONS: usize = 40;
+
+/// The strafe angle of a frame that turns the velocity by `wanted_rad` for the least speed (docs/physics.md
+/// sections 6 and 9), as `cos theta`: the maximum-acceleration angle where that turns at least as much;
+/// else the angle between it and the sharpest turn's that turns by `wanted_rad` (bisection: from the
+/// maximum-acceleration angle to the sharpest turn's the speed falls as `theta` grows, so the first angle
+/// that turns enough loses the least); else, where no frame turns that far, the sharpest turn's.
+pub fn turning_cos_theta(lambda: f64, law: AccelLaw, wanted_rad: f64) -> f64 {
+    let accel_cos = max_accel_cos_theta(lambda, law).1;
+    if turn_at(lambda, accel_cos, law) >= wanted_rad {
+        return accel_cos;
+    }
+    let (sharp_theta, sharp_turn) = sharpest_turn(lambda, law);
+    if sharp_turn <= wanted_rad {
+        return sharp_theta.cos();
+    }
+    let (mut lo, mut hi) = (theta_from_cos(accel_cos), sharp_theta);
+    for _ in 0..TURN_BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        if turn_at(lambda, mid.cos(), law) >= wanted_rad {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi.cos()
+}
+
 /// The maximum-acceleration control of this frame for a player holding the keys `forwardmove`, `sidemove`,
 /// turning to `side`: the stepper's own friction and law are applied to a copy of the state, then the yaw is
 /// set so that the wish direction makes the angle [`max_accel_theta`] with `lambda(v)` (docs/physics.md
@@ -386,6 +425,46 @@ mod tests {
                 "{lam} {l} {g}: {m:?} vs {direct}"
             );
             assert!(m.speed.is_finite() && m.cos_theta.abs() <= 1.0);
+        }
+    }
+
+    #[test]
+    fn a_wanted_turn_is_made_for_the_least_speed_of_any_angle_that_turns_as_far() {
+        // Both cases of the air (1000 fps with air acceleration 10; 100 fps with 100) and a slow start.
+        for &(lam, l, g) in &[
+            (700.0, 30.0, 3.2),
+            (1200.0, 30.0, 320.0),
+            (90.0, 30.0, 32.0),
+        ] {
+            let law = law(l, g);
+            let accel_cos = max_accel_cos_theta(lam, law).1;
+            let accel_turn = turn_at(lam, accel_cos, law);
+            let (sharp_theta, sharp_turn) = sharpest_turn(lam, law);
+            // Up to the maximum-acceleration turn: maximum acceleration (it turns at least as far).
+            assert_eq!(turning_cos_theta(lam, law, 0.5 * accel_turn), accel_cos);
+            // Beyond the sharpest turn: the sharpest.
+            let beyond = turning_cos_theta(lam, law, 2.0 * sharp_turn);
+            assert!((beyond - sharp_theta.cos()).abs() < 1e-12, "{lam} {l} {g}");
+            for share in [0.1, 0.5, 0.9] {
+                let wanted = accel_turn + share * (sharp_turn - accel_turn);
+                let c = turning_cos_theta(lam, law, wanted);
+                let turn = turn_at(lam, c, law);
+                assert!(
+                    (turn - wanted).abs() < 1e-9,
+                    "{lam} {l} {g} {share}: {turn} for {wanted}"
+                );
+                // No angle on a fine grid turns as far and keeps more speed.
+                let speed = speed_after(lam, c, law);
+                for i in 0..=2000 {
+                    let other = -1.0 + 2.0 * f64::from(i) / 2000.0;
+                    if turn_at(lam, other, law) >= wanted {
+                        assert!(
+                            speed_after(lam, other, law) <= speed + 1e-9,
+                            "{lam} {l} {g} {share}: cos {other} keeps more than {c}"
+                        );
+                    }
+                }
+            }
         }
     }
 

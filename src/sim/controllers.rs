@@ -5,7 +5,7 @@ use super::{Controller, RunSummary, Simulation, Trace};
 use crate::budget::Budget;
 use crate::physics::strafe::{
     max_accel_control, max_accel_cos_theta, max_decel, speed_preserving_cos_theta, strafe_keys,
-    strafe_wish,
+    strafe_wish, turning_cos_theta,
 };
 use crate::physics::{Control, Effect, PlayerState, Side, Vec2, Wish};
 
@@ -74,6 +74,7 @@ pub struct Greedy {
     last_side: Side,
     speed_cap_ups: Option<f64>,
     corner_speeds: Option<CornerSpeeds>,
+    sharp_turns: bool,
 }
 
 /// A stretch of the guide path taken at a speed no higher than `speed_ups`: a corner, from
@@ -132,6 +133,7 @@ impl Greedy {
             last_side: Side::Right,
             speed_cap_ups: None,
             corner_speeds: None,
+            sharp_turns: false,
         }
     }
 
@@ -148,6 +150,18 @@ impl Greedy {
     /// before and through them.
     pub fn with_corner_speeds(mut self, speeds: CornerSpeeds) -> Self {
         self.corner_speeds = Some(speeds);
+        self
+    }
+
+    /// The same strafer turning as sharply as its target needs: where the maximum-acceleration turn is
+    /// less than the turn onto the arc that reaches the look-ahead target (pure pursuit: curvature
+    /// `2 sin(alpha) / d` for a target `d` units away, `alpha` off the velocity, over the frame's move), it
+    /// strafes at the angle that turns that much for the least speed (docs/physics.md section 9), up to
+    /// the sharpest turn. In the air's second case (`gamma1 > L`, air acceleration 100) such a frame
+    /// turns several times faster than maximum acceleration for a few ups of speed, so corners are taken
+    /// fast instead of slowed for.
+    pub fn with_sharp_turns(mut self) -> Self {
+        self.sharp_turns = true;
         self
     }
 
@@ -217,9 +231,10 @@ impl Controller for Greedy {
         } else {
             ""
         };
+        let turns = if self.sharp_turns { "-sharp-turns" } else { "" };
         match self.speed_cap_ups {
-            None => format!("greedy{corners}"),
-            Some(cap) => format!("greedy-capped-{cap:.0}{corners}"),
+            None => format!("greedy{corners}{turns}"),
+            Some(cap) => format!("greedy-capped-{cap:.0}{corners}{turns}"),
         }
     }
 
@@ -297,9 +312,36 @@ impl Greedy {
                     },
                 ))
             }
+            _ if self.sharp_turns => {
+                let wanted_rad = pursuit_turn_rad(s.vel, to_target, sim.scene().frame_time_s());
+                Control::from_wish(&strafe_wish(
+                    sim.stepper(),
+                    s,
+                    keys,
+                    side,
+                    to_target.angle(),
+                    |lambda, law| turning_cos_theta(lambda, law, wanted_rad),
+                ))
+            }
             _ => max_accel_control(sim.stepper(), s, keys, side, to_target.angle()),
         }
     }
+}
+
+/// The turn of one frame onto the arc that leaves along `vel` and reaches a target `to_target` away
+/// (pure pursuit), radians: the arc's curvature `2 sin(alpha) / d` over the frame's move `|vel| tau_s`.
+/// A target behind (`alpha >= 90` degrees) asks for the sharpest turn there is (infinity).
+fn pursuit_turn_rad(vel: Vec2, to_target: Vec2, tau_s: f64) -> f64 {
+    let (speed, d) = (vel.length(), to_target.length());
+    if speed <= 0.0 || d <= 0.0 {
+        // No heading to turn from: maximum acceleration towards the target.
+        return 0.0;
+    }
+    if vel.dot(to_target) <= 0.0 {
+        return f64::INFINITY;
+    }
+    let sin_alpha = vel.cross(to_target).abs() / (speed * d);
+    2.0 * sin_alpha / d * speed * tau_s
 }
 
 /// How often the greedy strafer halves its look-ahead looking for a target in plain sight.
@@ -398,6 +440,22 @@ pub fn best_capped_greedy_within(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pursuit_turns_onto_the_arc_through_the_target() {
+        // At 1000 ups along +x, 10 ms a frame: a target on the circle of radius 200 tangent to the
+        // velocity (centre at (0, 200)), 40 degrees round it, asks for 10 units of that arc: 0.05 rad.
+        let vel = Vec2::new(1000.0, 0.0);
+        let phi = 40f64.to_radians();
+        let target = Vec2::new(200.0 * phi.sin(), 200.0 * (1.0 - phi.cos()));
+        let turn = pursuit_turn_rad(vel, target, 0.01);
+        assert!((turn - 0.05).abs() < 1e-12, "{turn}");
+        // The same to the right; a target straight ahead asks for none; one behind for the sharpest.
+        let mirrored = Vec2::new(target.x, -target.y);
+        assert!((pursuit_turn_rad(vel, mirrored, 0.01) - 0.05).abs() < 1e-12);
+        assert!(pursuit_turn_rad(vel, Vec2::new(300.0, 0.0), 0.01).abs() < 1e-15);
+        assert!(pursuit_turn_rad(vel, Vec2::new(-1.0, 5.0), 0.01).is_infinite());
+    }
 
     #[test]
     fn a_corner_speed_holds_through_its_corner_and_braking_distance_raises_it_before() {
