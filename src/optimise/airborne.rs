@@ -10,7 +10,7 @@
 //!    fastest valid exact plan is kept.
 
 use super::baseline::Baseline;
-use super::model::FrameControl;
+use super::model::{rollout, FrameControl};
 use super::planner::Planner;
 use super::polish::{rounded_and_polished, MARGIN_RETRIES};
 use super::relaxed::{
@@ -106,8 +106,12 @@ pub(super) fn plan_airborne(
     for side_certifier in side_certifiers {
         certifier.absorb(side_certifier);
     }
-    // A greedy start whose relaxed line is faster than the relaxed plan's: its line is rounded too.
-    if let Some(plan) = certifier.best().filter(|p| p.start_index > 0) {
+    // A greedy start whose relaxed line is faster than the relaxed plan's (by more than the stages can
+    // tell apart): its line is rounded too.
+    let same_optimum_s = certifier
+        .best()
+        .map_or(0.0, |p| same_optimum_s(planner, &p.controls));
+    if let Some(plan) = certifier.ahead_of_the_first(same_optimum_s) {
         let line = plan.controls.clone();
         plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, &mut best);
     }
@@ -122,6 +126,19 @@ pub(super) fn plan_airborne(
         best,
         certifier,
         relaxed_found: true,
+    }
+}
+
+/// How far apart in time two lines of the certificate's problem may cross and still be one optimum to the
+/// SCP stages, seconds: their tolerance in progress (`tol_progress_units`) at `line`'s speed at its end.
+fn same_optimum_s(planner: &Planner, line: &[FrameControl]) -> f64 {
+    let speed = rollout(&planner.start, line, &planner.fl)
+        .last()
+        .map_or(0.0, |s| s.speed);
+    if speed > 0.0 {
+        planner.settings.tol_progress_units / speed
+    } else {
+        0.0
     }
 }
 

@@ -343,6 +343,8 @@ pub(super) struct Certifier {
 /// Where a start of the certificate ended.
 #[derive(Clone, Copy, Debug)]
 struct StartEnd {
+    /// Which start, in the order tried (absorbed starts after this certifier's own).
+    index: usize,
     /// Its line's crossing time, seconds.
     time: f64,
     /// Whether its search stopped short of its local optimum ([`Descended::short`]).
@@ -408,6 +410,7 @@ impl Certifier {
             return false;
         };
         self.ends.push(StartEnd {
+            index,
             time: crossing.time,
             short,
         });
@@ -430,7 +433,10 @@ impl Certifier {
     pub(super) fn absorb(&mut self, other: Certifier) {
         let offset = self.tried;
         self.tried += other.tried;
-        self.ends.extend(other.ends);
+        self.ends.extend(other.ends.into_iter().map(|e| StartEnd {
+            index: e.index + offset,
+            ..e
+        }));
         if let Some(plan) = other.best {
             if self
                 .best
@@ -448,6 +454,17 @@ impl Certifier {
     /// The fastest relaxed plan so far.
     pub(super) fn best(&self) -> Option<&CertifiedPlan> {
         self.best.as_ref()
+    }
+
+    /// The fastest relaxed plan, if a start after the first found it more than `same_optimum_s` seconds
+    /// before the first start's line (or the first reached nothing): another local optimum than the
+    /// first start's, not the same one found again to within the stages' tolerance.
+    pub(super) fn ahead_of_the_first(&self, same_optimum_s: f64) -> Option<&CertifiedPlan> {
+        let best = self.best.as_ref().filter(|b| b.start_index > 0)?;
+        let first = self.ends.iter().find(|e| e.index == 0).map(|e| e.time);
+        first
+            .is_none_or(|t| best.crossing.time < t - same_optimum_s)
+            .then_some(best)
     }
 
     /// The crossing time of the fastest relaxed plan so far, seconds.
@@ -496,7 +513,9 @@ mod tests {
             tried,
             ends: ends
                 .iter()
-                .map(|&(f, short)| StartEnd {
+                .enumerate()
+                .map(|(index, &(f, short))| StartEnd {
+                    index,
                     time: crossing(f).time,
                     short,
                 })
@@ -532,6 +551,29 @@ mod tests {
             .certificate()
             .unwrap_or_else(|| panic!("no certificate"));
         assert_eq!((c.starts, c.reached), (6, 4));
+    }
+
+    #[test]
+    fn a_later_start_is_another_line_only_when_ahead_of_the_first_by_more_than_the_tolerance() {
+        // Through frame 100 at 100 fps: the first start at 0.5 of the frame, the second 1e-5 of a frame
+        // (1e-7 s) before it.
+        let c = certifier_of(2, &[0.5, 0.5 - 1e-5], 1);
+        assert!(c.ahead_of_the_first(1e-6).is_none());
+        assert_eq!(c.ahead_of_the_first(1e-8).map(|b| b.start_index), Some(1));
+        // The first start's own line is never another.
+        assert!(certifier_of(2, &[0.4, 0.5], 0)
+            .ahead_of_the_first(0.0)
+            .is_none());
+        // Where the first start reached nothing, a later start's line is the only one.
+        let mut first_short = Certifier {
+            tried: 1,
+            ..Certifier::default()
+        };
+        first_short.absorb(certifier_of(1, &[0.5], 0));
+        assert_eq!(
+            first_short.ahead_of_the_first(1.0).map(|b| b.start_index),
+            Some(1)
+        );
     }
 
     #[test]
