@@ -185,3 +185,56 @@ fn an_unwritable_trajectory_is_one_line_with_exit_1() {
         "/nonexistent-dir/x.csv",
     );
 }
+
+#[test]
+fn sharp_turns_take_a_fast_hairpin_sooner_and_report_rebuilds_them() {
+    // The shipped hairpin at air acceleration 100, entered at 1200 ups: maximum acceleration turns on an
+    // arc of about 480 units there, a sharp frame on one of about 44 (docs/physics.md section 9).
+    let dir = temp_dir("sharp-turns");
+    let scene = dir.join("hairpin-aa100.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "hairpin-aa100"
+[engine]
+preset = "goldsrc"
+fps = 100
+airaccelerate = 100
+effects = ["air-accel", "max-velocity", "walls"]
+[start]
+velocity = [1200, 0]
+on-ground = false
+[hairpin]
+width = 128
+length = 1200
+gap = 64
+finish = 1200
+kind = "rule"
+"#,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let scene = scene.display().to_string();
+    let greedy = json(&["simulate", &scene, "--json"]);
+    let sharp = json(&["simulate", &scene, "--controller", "sharp-turns", "--json"]);
+    assert_eq!(sharp["controller"], "greedy-sharp-turns");
+    let frames = |v: &Value| v["frames"].as_u64().unwrap_or(u64::MAX);
+    // Measured along the shortest path (both brush the divider's rule line there; `solve`'s baseline
+    // keeps the guide off it): 230 frames turning sharply, 2327 at maximum acceleration, which cannot
+    // turn round the divider at this speed and strays far down the far leg.
+    assert!(frames(&sharp) <= 240, "{sharp}");
+    assert!(frames(&greedy) > 4 * frames(&sharp), "{greedy}");
+    // The result names its controller and look-ahead, and `report` plays it again to the same frame.
+    let result = dir.join("r.json");
+    std::fs::write(&result, sharp.to_string()).unwrap_or_else(|e| panic!("{e}"));
+    let html = dir.join("r.html");
+    let out = common::strafeopt(&[
+        "report",
+        &result.display().to_string(),
+        "-o",
+        &html.display().to_string(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -18,7 +18,7 @@ use crate::optimise::{lower_bound, solve, Quality, SearchSettings, SearchStatus}
 use crate::physics::Side;
 use crate::scene::expect::{ExpectController, ExpectQuality};
 use crate::scene::{self, Expectation, ExpectedRun, Limits, Scene};
-use crate::sim::controllers::{best_greedy, GREEDY_LOOKAHEADS_UNITS};
+use crate::sim::controllers::{best_greedy, best_sharp_turning_greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{SideStrafer, Simulation};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -433,6 +433,7 @@ fn quality_name(q: ExpectQuality) -> &'static str {
 fn controller_name(c: ExpectController) -> &'static str {
     match c {
         ExpectController::Greedy => "greedy",
+        ExpectController::SharpTurns => "sharp-turns",
         ExpectController::MaxAccelLeft => "max-accel-left",
         ExpectController::MaxAccelRight => "max-accel-right",
         ExpectController::Abh => "abh",
@@ -485,6 +486,9 @@ pub fn measure(scene: &Scene, run: ExpectedRun) -> Result<Measured> {
             let trace = match controller {
                 ExpectController::Greedy => {
                     best_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS).0
+                }
+                ExpectController::SharpTurns => {
+                    best_sharp_turning_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS).0
                 }
                 ExpectController::MaxAccelLeft => sim.run(&mut SideStrafer { side: Side::Left }),
                 ExpectController::MaxAccelRight => sim.run(&mut SideStrafer { side: Side::Right }),

@@ -135,6 +135,9 @@ pub struct ReportArgs {
 pub enum ControllerArg {
     /// Maximum acceleration, steering left or right towards a look-ahead point on the shortest path.
     Greedy,
+    /// The greedy strafer, turning harder than maximum acceleration where its look-ahead target needs it:
+    /// the frame that turns far enough for the least speed (docs/physics.md section 9).
+    SharpTurns,
     /// Maximum acceleration turning left every frame.
     MaxAccelLeft,
     /// Maximum acceleration turning right every frame.

@@ -4,8 +4,8 @@
 //! names what made the run, and the simulation is deterministic, so `report` re-runs it:
 //! - `scene_path`: the scene file (absolute when saved; a relative path is tried from the working
 //!   directory, then from the result file's directory). The scene is loaded and validated again.
-//! - `controller` and `lookahead`: `greedy` (with its look-ahead, units), `max-accel-left` or
-//!   `max-accel-right` are run again on the scene.
+//! - `controller` and `lookahead`: `greedy` and `greedy-sharp-turns` (with its look-ahead, units),
+//!   `max-accel-left` or `max-accel-right` are run again on the scene.
 //! - `plans` (optional): `[{"label": "optimised", "controls": [Control, ...]}]`, each control as serde
 //!   writes [`Control`] (`yaw_rad`, `forwardmove`, `sidemove`, `jump`, `duck`), replayed frame by frame.
 //!   This is how a `solve --json` result carries its optimised plan; its `controller` may then name a
@@ -127,7 +127,7 @@ pub fn rebuild(result: &Value, origin: &str, base_dir: &Path) -> Result<Rebuilt>
         .and_then(Value::as_str)
         .unwrap_or("");
     let recorded = match controller {
-        "greedy" => {
+        "greedy" | "greedy-sharp-turns" => {
             let la = result
                 .get("lookahead")
                 .and_then(Value::as_f64)
@@ -139,7 +139,13 @@ pub fn rebuild(result: &Value, origin: &str, base_dir: &Path) -> Result<Rebuilt>
                         "missing or not a finite number above 0; a greedy result records its look-ahead",
                     )
                 })?;
-            Some(sim.run(&mut Greedy::new(bound.path.clone(), la)))
+            let strafer = Greedy::new(bound.path.clone(), la);
+            let mut strafer = if controller == "greedy" {
+                strafer
+            } else {
+                strafer.with_sharp_turns()
+            };
+            Some(sim.run(&mut strafer))
         }
         "abh" => Some(sim.run(&mut crate::sim::abh::Abh::default())),
         "max-accel-left" => Some(sim.run(&mut SideStrafer { side: Side::Left })),
@@ -171,8 +177,8 @@ pub fn rebuild(result: &Value, origin: &str, base_dir: &Path) -> Result<Rebuilt>
             origin,
             "controller",
             format!(
-                "{controller:?}: must be greedy, abh, max-accel-left or max-accel-right, or the result must carry \
-                 `plans`"
+                "{controller:?}: must be greedy, greedy-sharp-turns, abh, max-accel-left or \
+                 max-accel-right, or the result must carry `plans`"
             ),
         ));
     }

@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::optimise::lower_bound;
 use crate::physics::{Game, Side};
 use crate::scene::Scene;
-use crate::sim::controllers::{best_greedy, GREEDY_LOOKAHEADS_UNITS};
+use crate::sim::controllers::{best_greedy, best_sharp_turning_greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{Greedy, SideStrafer, Simulation, Trace};
 use serde_json::{json, Value};
 
@@ -18,16 +18,28 @@ pub fn run(args: &SimulateArgs) -> Result<String> {
     }
     let sim = Simulation::new(&scene)?;
     let bound = lower_bound(&scene, sim.corridor())?;
+    let lookahead = match args.lookahead {
+        Some(la) if !(la.is_finite() && la > 0.0) => {
+            return Err(Error::invalid("--lookahead", la, "a finite number above 0"));
+        }
+        la => la,
+    };
     let (trace, lookahead) = match args.controller {
-        ControllerArg::Greedy => match args.lookahead {
-            Some(la) => {
-                if !(la.is_finite() && la > 0.0) {
-                    return Err(Error::invalid("--lookahead", la, "a finite number above 0"));
-                }
-                (sim.run(&mut Greedy::new(bound.path.clone(), la)), Some(la))
-            }
+        ControllerArg::Greedy => match lookahead {
+            Some(la) => (sim.run(&mut Greedy::new(bound.path.clone(), la)), Some(la)),
             None => {
                 let (t, la) = best_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS);
+                (t, Some(la))
+            }
+        },
+        ControllerArg::SharpTurns => match lookahead {
+            Some(la) => {
+                let mut strafer = Greedy::new(bound.path.clone(), la).with_sharp_turns();
+                (sim.run(&mut strafer), Some(la))
+            }
+            None => {
+                let (t, la) =
+                    best_sharp_turning_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS);
                 (t, Some(la))
             }
         },

@@ -91,6 +91,8 @@ pub enum ExpectQuality {
 pub enum ExpectController {
     /// The greedy strafer, best of its look-aheads.
     Greedy,
+    /// The greedy strafer turning as sharply as its target needs, best of its look-aheads.
+    SharpTurns,
     /// Maximum acceleration turning left.
     MaxAccelLeft,
     /// Maximum acceleration turning right.

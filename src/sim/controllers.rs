@@ -368,6 +368,16 @@ pub fn best_greedy(sim: &Simulation, path: &[Vec2], lookaheads: &[f64]) -> (Trac
     (t, la)
 }
 
+/// [`best_greedy`] for the strafer turning as sharply as its target needs ([`Greedy::with_sharp_turns`]).
+pub fn best_sharp_turning_greedy(
+    sim: &Simulation,
+    path: &[Vec2],
+    lookaheads: &[f64],
+) -> (Trace, f64) {
+    let (t, la, _) = best_of_sweep(sim, path, lookaheads, &[], true, &Budget::unlimited());
+    (t, la)
+}
+
 /// Sort key of a run: feasible crossings first by time, then infeasible crossings by time, then the rest
 /// by how far along the guide path they ended (further is better).
 fn rank(t: &RunSummary, guide: &Greedy) -> (u8, f64) {
@@ -400,13 +410,28 @@ pub fn best_capped_greedy_within(
     caps_ups: &[f64],
     budget: &Budget,
 ) -> (Trace, f64, Option<f64>) {
+    best_of_sweep(sim, path, lookaheads, caps_ups, false, budget)
+}
+
+/// The sweep of [`best_capped_greedy_within`], the strafer turning sharply if `sharp_turns`.
+fn best_of_sweep(
+    sim: &Simulation,
+    path: &[Vec2],
+    lookaheads: &[f64],
+    caps_ups: &[f64],
+    sharp_turns: bool,
+    budget: &Budget,
+) -> (Trace, f64, Option<f64>) {
     let guide = Greedy::new(path.to_vec(), 0.0);
     let make = |la: f64, cap: Option<f64>| {
-        let g = Greedy::new(path.to_vec(), la);
-        match cap {
-            Some(cap) => g.with_speed_cap(cap),
-            None => g,
+        let mut g = Greedy::new(path.to_vec(), la);
+        if let Some(cap) = cap {
+            g = g.with_speed_cap(cap);
         }
+        if sharp_turns {
+            g = g.with_sharp_turns();
+        }
+        g
     };
     // (rank, run, look-ahead, cap) of the best run so far.
     type Best = ((u8, f64), RunSummary, f64, Option<f64>);
