@@ -91,7 +91,8 @@ pub(super) fn plan_airborne(
 ) -> AirbornePlan {
     let margins = LineMargins::of(planner);
     let greedy_starts = certificate_greedy_starts(planner, base);
-    let side = move |fork: &mut Planner| certified_greedy_starts(fork, greedy_starts, lo);
+    let planning = Relaxation::planning(margins.planning);
+    let side = move |fork: &mut Planner| certified_greedy_starts(fork, greedy_starts, planning, lo);
     let (mine, side_certifiers) = planner.beside_forks(vec![side], |planner| {
         lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress)
     });
@@ -214,15 +215,18 @@ fn certificate_greedy_starts(planner: &Planner, base: &Baseline) -> Vec<Vec<Fram
         .collect()
 }
 
-/// The certificate's greedy starts, solved by `planner` (a fork, on its own thread).
+/// The certificate's greedy starts, solved by `planner` (a fork, on its own thread); `planning` is the
+/// relaxed plan's problem (see [`StartKind::Greedy`]).
 fn certified_greedy_starts(
     planner: &mut Planner,
     starts: Vec<Vec<FrameControl>>,
+    planning: Relaxation,
     lo: usize,
 ) -> Certifier {
     let mut certifier = Certifier::default();
     for warm in starts {
-        certifier.add_start(planner, &mut |_| {}, warm, StartKind::Greedy, lo);
+        let kind = StartKind::Greedy { planning };
+        certifier.add_start(planner, &mut |_| {}, warm, kind, lo);
     }
     certifier
 }

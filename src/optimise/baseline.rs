@@ -576,7 +576,9 @@ fn is_clean(t: &Trace) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimise::planner::{planning_inputs, staircase_scene};
+    use crate::optimise::planner::{
+        fast_hairpin_at_air_acceleration_100, planning_inputs, staircase_scene,
+    };
 
     #[test]
     fn a_corner_wrapped_by_several_vertices_counts_as_one_turn() {
@@ -647,29 +649,6 @@ mod tests {
         assert!(by_turn.windows(2).all(|w| w[1].1 < w[0].1), "{by_turn:?}");
         let gamma1 = air_law(&scene.vars).gamma1;
         assert!((speeds.braking_ups_per_s - gamma1 * 100.0).abs() < 1e-9);
-    }
-
-    /// The shipped hairpin (128-unit legs around a 64-unit divider) at air acceleration 100, entered at
-    /// 1200 ups.
-    fn fast_hairpin_at_air_acceleration_100() -> Scene {
-        let text = r#"
-name = "hairpin-aa100"
-[engine]
-preset = "goldsrc"
-fps = 100
-airaccelerate = 100
-effects = ["air-accel", "max-velocity", "walls"]
-[start]
-velocity = [1200, 0]
-on-ground = false
-[hairpin]
-width = 128
-length = 1200
-gap = 64
-finish = 1200
-kind = "rule"
-"#;
-        Scene::from_toml_str(text, "test").unwrap_or_else(|e| panic!("{e}"))
     }
 
     #[test]
