@@ -188,33 +188,12 @@ fn an_unwritable_trajectory_is_one_line_with_exit_1() {
 
 #[test]
 fn sharp_turns_take_a_fast_hairpin_sooner_and_report_rebuilds_them() {
-    // The shipped hairpin at air acceleration 100, entered at 1200 ups: maximum acceleration turns on an
-    // arc of about 480 units there, a sharp frame on one of about 44 (docs/physics.md section 9).
+    // The hairpin at air acceleration 100, entered at 1200 ups: maximum acceleration turns on an arc of
+    // about 480 units there, a sharp frame on one of about 44 (docs/physics.md section 9).
     let dir = temp_dir("sharp-turns");
-    let scene = dir.join("hairpin-aa100.toml");
-    std::fs::write(
-        &scene,
-        r#"name = "hairpin-aa100"
-[engine]
-preset = "goldsrc"
-fps = 100
-airaccelerate = 100
-effects = ["air-accel", "max-velocity", "walls"]
-[start]
-velocity = [1200, 0]
-on-ground = false
-[hairpin]
-width = 128
-length = 1200
-gap = 64
-finish = 1200
-kind = "rule"
-"#,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let scene = scene.display().to_string();
-    let greedy = json(&["simulate", &scene, "--json"]);
-    let sharp = json(&["simulate", &scene, "--controller", "sharp-turns", "--json"]);
+    let scene = "scenarios/hl-hairpin-aa100-100fps.toml";
+    let greedy = json(&["simulate", scene, "--json"]);
+    let sharp = json(&["simulate", scene, "--controller", "sharp-turns", "--json"]);
     assert_eq!(sharp["controller"], "greedy-sharp-turns");
     let frames = |v: &Value| v["frames"].as_u64().unwrap_or(u64::MAX);
     // Measured along the shortest path (both brush the divider's rule line there; `solve`'s baseline

@@ -300,27 +300,11 @@ pub(super) fn staircase_scene(corners: u32) -> Scene {
     staircase(&spec).unwrap_or_else(|e| panic!("{e}")).scene
 }
 
-/// The shipped hairpin (128-unit legs around a 64-unit divider) at air acceleration 100, entered at
-/// 1200 ups.
+/// `scenarios/hl-hairpin-aa100-100fps.toml`: the shipped hairpin (128-unit legs around a 64-unit
+/// divider) at air acceleration 100, entered at 1200 ups.
 #[cfg(test)]
 pub(super) fn fast_hairpin_at_air_acceleration_100() -> Scene {
-    let text = r#"
-name = "hairpin-aa100"
-[engine]
-preset = "goldsrc"
-fps = 100
-airaccelerate = 100
-effects = ["air-accel", "max-velocity", "walls"]
-[start]
-velocity = [1200, 0]
-on-ground = false
-[hairpin]
-width = 128
-length = 1200
-gap = 64
-finish = 1200
-kind = "rule"
-"#;
+    let text = include_str!("../../scenarios/hl-hairpin-aa100-100fps.toml");
     Scene::from_toml_str(text, "test").unwrap_or_else(|e| panic!("{e}"))
 }
 
