@@ -242,7 +242,7 @@ struct GuidePath {
 /// cap held once reached, or the corner speeds of bends of a width, units for the hull centre), or
 /// turning harder than maximum acceleration as its target needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum SpeedLimit {
+enum Cornering {
     Cap(f64),
     CornerSpeeds(f64),
     SharpTurns,
@@ -324,14 +324,12 @@ pub(super) fn baseline(
     // in both arithmetics: maximum acceleration overshoots a sharp corner of a narrow corridor, and along
     // a solid wall it scrapes where the game's f32 replay parts ways.
     let on_ground = !fx.is_air_only();
-    let limits: Vec<SpeedLimit> = if fx.is_air_only() {
+    let cornering: Vec<Cornering> = if fx.is_air_only() {
         let caps = corner_caps(scene, &bound.path)
             .into_iter()
-            .map(SpeedLimit::Cap);
-        let corners = CAP_WIDTHS_UNITS
-            .iter()
-            .map(|&w| SpeedLimit::CornerSpeeds(w));
-        std::iter::once(SpeedLimit::SharpTurns)
+            .map(Cornering::Cap);
+        let corners = CAP_WIDTHS_UNITS.iter().map(|&w| Cornering::CornerSpeeds(w));
+        std::iter::once(Cornering::SharpTurns)
             .chain(caps)
             .chain(corners)
             .collect()
@@ -344,7 +342,7 @@ pub(super) fn baseline(
     sweep_guides(
         sim,
         &guides,
-        &limits,
+        &cornering,
         true,
         broken_frame_limit,
         budget,
@@ -353,9 +351,9 @@ pub(super) fn baseline(
     let mut greedy = pick_greedy(sim, &guides, &runs, &[], budget);
     if on_ground && !greedy.engine_valid && !budget.expired() {
         let checked = runs.valid.clone();
-        let caps: Vec<SpeedLimit> = ground_caps(scene, &bound.path)
+        let caps: Vec<Cornering> = ground_caps(scene, &bound.path)
             .into_iter()
-            .map(SpeedLimit::Cap)
+            .map(Cornering::Cap)
             .collect();
         sweep_guides(
             sim,
@@ -425,33 +423,30 @@ fn replay(sim: &Simulation, guides: &[GuidePath], i: usize, guide: GreedyGuide) 
     }
 }
 
-/// Plays every guide at every look-ahead, with no limit first when `uncapped`, then each of `limits`, for
+/// Plays every guide at every look-ahead, plain first when `uncapped`, then each way of `cornering`, for
 /// their verdicts only, into `runs` (kept sorted fastest first).
 fn sweep_guides(
     sim: &Simulation,
     guides: &[GuidePath],
-    limits: &[SpeedLimit],
+    cornering: &[Cornering],
     uncapped: bool,
     broken_frame_limit: u64,
     budget: &Budget,
     runs: &mut GuideRuns,
 ) {
     let first = uncapped.then_some(None);
-    'sweep: for limit in first.into_iter().chain(limits.iter().copied().map(Some)) {
-        let (cap, corner_bend_units, sharp_turns) = match limit {
+    'sweep: for way in first.into_iter().chain(cornering.iter().copied().map(Some)) {
+        let (cap, corner_bend_units, sharp_turns) = match way {
             None => (None, None, false),
-            Some(SpeedLimit::Cap(cap)) => (Some(cap), None, false),
-            Some(SpeedLimit::CornerSpeeds(w)) => (None, Some(w), false),
-            Some(SpeedLimit::SharpTurns) => (None, None, true),
+            Some(Cornering::Cap(cap)) => (Some(cap), None, false),
+            Some(Cornering::CornerSpeeds(w)) => (None, Some(w), false),
+            Some(Cornering::SharpTurns) => (None, None, true),
         };
         // Speed-limited runs along the shortest path and the widest guide only: the limits are for corners
         // the uncapped strafer overshoots, and every guide in between would multiply the runs. Sharp turns
         // keep the speed, so the guide they follow matters as much as the plain strafer's.
         let last = guides.len() - 1;
-        let limited = matches!(
-            limit,
-            Some(SpeedLimit::Cap(_) | SpeedLimit::CornerSpeeds(_))
-        );
+        let limited = matches!(way, Some(Cornering::Cap(_) | Cornering::CornerSpeeds(_)));
         for (i, g) in guides.iter().enumerate() {
             if limited && i != 0 && i != last {
                 continue;
@@ -671,21 +666,17 @@ mod tests {
             .fold(f64::INFINITY, f64::min);
         // The best valid run of every other strafer.
         let guides = guide_paths(&scene, &bound);
-        let limits: Vec<SpeedLimit> = corner_caps(&scene, &bound.path)
+        let cornering: Vec<Cornering> = corner_caps(&scene, &bound.path)
             .into_iter()
-            .map(SpeedLimit::Cap)
-            .chain(
-                CAP_WIDTHS_UNITS
-                    .iter()
-                    .map(|&w| SpeedLimit::CornerSpeeds(w)),
-            )
+            .map(Cornering::Cap)
+            .chain(CAP_WIDTHS_UNITS.iter().map(|&w| Cornering::CornerSpeeds(w)))
             .collect();
         let mut runs = GuideRuns::default();
         let limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames;
         sweep_guides(
             &sim,
             &guides,
-            &limits,
+            &cornering,
             true,
             limit,
             &Budget::unlimited(),
@@ -706,9 +697,9 @@ mod tests {
         let scene = staircase_scene(5);
         let (sim, bound, _) = planning_inputs(&scene);
         let guides = guide_paths(&scene, &bound);
-        let corner_speeds: Vec<SpeedLimit> = CAP_WIDTHS_UNITS
+        let corner_speeds: Vec<Cornering> = CAP_WIDTHS_UNITS
             .iter()
-            .map(|&w| SpeedLimit::CornerSpeeds(w))
+            .map(|&w| Cornering::CornerSpeeds(w))
             .collect();
         let mut runs = GuideRuns::default();
         let limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames;
