@@ -726,8 +726,10 @@ mod tests {
                 let start = warm.clone();
                 line = relaxed_plan(&mut planner, record, start, n, 0, certificate, descent).line;
             });
-            // The knots are tried first and reach nothing (a count over knots of 4 frames).
-            assert!(counts.first().is_some_and(|&c| c > n), "{counts:?}");
+            // Knots first (4 frames each): the count search's first count is theirs.
+            let knot = coarse_knot_frames(n, CoarseRuns::AlsoShort) as usize;
+            assert_eq!(knot, 4);
+            assert!(counts.first().is_some_and(|&c| c % knot == 0), "{counts:?}");
             let frames = line
                 .as_deref()
                 .and_then(|l| planner.crossing_of(l))
