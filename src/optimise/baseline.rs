@@ -325,13 +325,8 @@ pub(super) fn baseline(
     // a solid wall it scrapes where the game's f32 replay parts ways.
     let on_ground = !fx.is_air_only();
     let cornering: Vec<Cornering> = if fx.is_air_only() {
-        let caps = corner_caps(scene, &bound.path)
-            .into_iter()
-            .map(Cornering::Cap);
-        let corners = CAP_WIDTHS_UNITS.iter().map(|&w| Cornering::CornerSpeeds(w));
         std::iter::once(Cornering::SharpTurns)
-            .chain(caps)
-            .chain(corners)
+            .chain(speed_limits(scene, &bound.path))
             .collect()
     } else {
         Vec::new()
@@ -377,6 +372,13 @@ pub(super) fn baseline(
         greedy: greedy.run,
         clean,
     }
+}
+
+/// The airborne ways of keeping the speed down for corners along `path`: the speed caps
+/// ([`corner_caps`]), then the corner speeds of bends of each of [`CAP_WIDTHS_UNITS`].
+fn speed_limits(scene: &Scene, path: &[Vec2]) -> impl Iterator<Item = Cornering> {
+    let caps = corner_caps(scene, path).into_iter().map(Cornering::Cap);
+    caps.chain(CAP_WIDTHS_UNITS.iter().map(|&w| Cornering::CornerSpeeds(w)))
 }
 
 /// The verdicts of the greedy runs swept so far, each as its crossing time (or rank), guide index and
@@ -646,6 +648,24 @@ mod tests {
         assert!((speeds.braking_ups_per_s - gamma1 * 100.0).abs() < 1e-9);
     }
 
+    /// The fastest valid run of the strafer along every guide of `scene` taking corners each of the ways
+    /// of `cornering` (and plain first if `plain`): its crossing time, seconds, and its guide.
+    fn fastest_valid(
+        scene: &Scene,
+        sim: &Simulation,
+        bound: &LowerBound,
+        cornering: &[Cornering],
+        plain: bool,
+    ) -> (f64, GreedyGuide) {
+        let mut runs = GuideRuns::default();
+        let limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames;
+        let guides = guide_paths(scene, bound);
+        let budget = Budget::unlimited();
+        sweep_guides(sim, &guides, cornering, plain, limit, &budget, &mut runs);
+        let (t, _, guide) = runs.valid[0];
+        (t, guide)
+    }
+
     #[test]
     fn at_air_acceleration_100_the_strafer_turning_sharply_takes_a_hairpin_at_speed() {
         // Maximum acceleration turns about L / V = 30 / 1200 rad a frame, an arc of 480 units: the plain
@@ -665,24 +685,8 @@ mod tests {
             .map(|r| r.speed)
             .fold(f64::INFINITY, f64::min);
         // The best valid run of every other strafer.
-        let guides = guide_paths(&scene, &bound);
-        let cornering: Vec<Cornering> = corner_caps(&scene, &bound.path)
-            .into_iter()
-            .map(Cornering::Cap)
-            .chain(CAP_WIDTHS_UNITS.iter().map(|&w| Cornering::CornerSpeeds(w)))
-            .collect();
-        let mut runs = GuideRuns::default();
-        let limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames;
-        sweep_guides(
-            &sim,
-            &guides,
-            &cornering,
-            true,
-            limit,
-            &Budget::unlimited(),
-            &mut runs,
-        );
-        let (other_s, _, other) = runs.valid[0];
+        let others: Vec<Cornering> = speed_limits(&scene, &bound.path).collect();
+        let (other_s, other) = fastest_valid(&scene, &sim, &bound, &others, true);
         // Measured: 200 frames, never under 1073 ups; the best other run 2.65 s (corner speeds).
         assert!(slowest > 800.0, "{slowest} ups through the hairpin");
         assert!(
@@ -696,27 +700,14 @@ mod tests {
         // One cap is the sharpest corner's speed held on every leg; corner speeds free the legs between.
         let scene = staircase_scene(5);
         let (sim, bound, _) = planning_inputs(&scene);
-        let guides = guide_paths(&scene, &bound);
         let corner_speeds: Vec<Cornering> = CAP_WIDTHS_UNITS
             .iter()
             .map(|&w| Cornering::CornerSpeeds(w))
             .collect();
-        let mut runs = GuideRuns::default();
-        let limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames;
-        let budget = Budget::unlimited();
-        sweep_guides(
-            &sim,
-            &guides,
-            &corner_speeds,
-            false,
-            limit,
-            &budget,
-            &mut runs,
-        );
-        let (best_s, _, guide) = runs.valid[0];
+        let (best_s, guide) = fastest_valid(&scene, &sim, &bound, &corner_speeds, false);
         assert!(guide.corner_bend_units.is_some(), "{guide}");
         let frames = (best_s / scene.frame_time_s()).ceil() as u64;
-        let shortest = &guides[0].path;
+        let shortest = &guide_paths(&scene, &bound)[0].path;
         let mut capped = u64::MAX;
         for cap in corner_caps(&scene, &bound.path) {
             for &la in &GREEDY_LOOKAHEADS_UNITS {

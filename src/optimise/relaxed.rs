@@ -518,6 +518,7 @@ impl Certifier {
 mod tests {
     use super::*;
     use crate::budget::Budget;
+    use crate::optimise::airborne::LineMargins;
     use crate::optimise::planner::{planning_inputs, staircase_scene};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
@@ -674,8 +675,8 @@ mod tests {
         let half = warm[..warm.len() / 2].to_vec();
         let n = half.len();
         let mut certifier = Certifier::default();
+        let planning = Relaxation::planning(LineMargins::of(&planner).planning);
         let counts = counts_tried(|record| {
-            let planning = Relaxation::planning(0.34);
             let kind = StartKind::Greedy { planning };
             certifier.add_start(&mut planner, record, half.clone(), kind, 0);
         });
@@ -712,8 +713,7 @@ mod tests {
         );
         let warm = planner.warm_start(&base.clean[1].trace);
         let n = warm.len();
-        let margins = super::super::airborne::LineMargins::of(&planner);
-        let planning = Relaxation::planning(margins.planning);
+        let planning = Relaxation::planning(LineMargins::of(&planner).planning);
         let certificate = Relaxation::certificate();
         let mut ends = Vec::new();
         for first in [Some(planning), None] {

@@ -203,8 +203,7 @@ pub fn speed_preserving_cos_theta(speed_before: f64, lambda: f64, law: AccelLaw)
 pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
     let turn = |theta: f64| {
         let (s, c) = theta.sin_cos();
-        let mu = mu_at(lambda, c, law);
-        (mu * s).atan2(lambda + mu * c)
+        turn_of(lambda, c, s, law)
     };
     let mut best = (0.0, turn(0.0));
     let consider = |theta: f64, best: &mut (f64, f64)| {
@@ -254,9 +253,15 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
 #[inline]
 pub fn turn_at(lambda: f64, cos_theta: f64, law: AccelLaw) -> f64 {
     let c = cos_theta.clamp(-1.0, 1.0);
-    let s = (1.0 - c * c).max(0.0).sqrt();
-    let mu = mu_at(lambda, c, law);
-    (mu * s).atan2(lambda + mu * c)
+    turn_of(lambda, c, (1.0 - c * c).max(0.0).sqrt(), law)
+}
+
+/// The turn of one frame at the angle whose cosine and sine are `cos_theta` and `sin_theta` (`>= 0`),
+/// radians: `atan2(mu sin theta, lambda + mu cos theta)`.
+#[inline]
+fn turn_of(lambda: f64, cos_theta: f64, sin_theta: f64, law: AccelLaw) -> f64 {
+    let mu = mu_at(lambda, cos_theta, law);
+    (mu * sin_theta).atan2(lambda + mu * cos_theta)
 }
 
 /// Bisection steps of [`turning_cos_theta`]: the angle to about `pi / 2^40`.
