@@ -426,7 +426,9 @@ fn replay(sim: &Simulation, guides: &[GuidePath], i: usize, guide: GreedyGuide) 
 }
 
 /// Plays every guide at every look-ahead, plain first when `uncapped`, then each way of `cornering`, for
-/// their verdicts only, into `runs` (kept sorted fastest first).
+/// their verdicts only, into `runs` (kept sorted fastest first). The guides are played side by side on
+/// the machine's cores and their verdicts gathered in the order of the sweep, so the runs kept are those
+/// of playing them one after the other.
 fn sweep_guides(
     sim: &Simulation,
     guides: &[GuidePath],
@@ -437,72 +439,155 @@ fn sweep_guides(
     runs: &mut GuideRuns,
 ) {
     let first = uncapped.then_some(None);
-    'sweep: for way in first.into_iter().chain(cornering.iter().copied().map(Some)) {
-        let (cap, corner_bend_units, sharp_turns) = match way {
-            None => (None, None, false),
-            Some(Cornering::Cap(cap)) => (Some(cap), None, false),
-            Some(Cornering::CornerSpeeds(w)) => (None, Some(w), false),
-            Some(Cornering::SharpTurns) => (None, None, true),
-        };
-        // Speed-limited runs along the shortest path and the widest guide only: the limits are for corners
-        // the uncapped strafer overshoots, and every guide in between would multiply the runs. Sharp turns
-        // keep the speed, so the guide they follow matters as much as the plain strafer's.
-        let last = guides.len() - 1;
-        let limited = matches!(way, Some(Cornering::Cap(_) | Cornering::CornerSpeeds(_)));
-        for (i, g) in guides.iter().enumerate() {
-            if limited && i != 0 && i != last {
-                continue;
-            }
-            // The corner speeds along this guide, the same at every look-ahead.
-            let corners = corner_bend_units.map(|w| corner_speeds(sim.scene(), &g.path, w));
-            let mut best_clean: Option<(f64, usize, GreedyGuide)> = None;
-            let mut best_valid: Option<(f64, usize, GreedyGuide)> = None;
-            // Ranks how far along this guide an unfinished run got.
-            let along = Greedy::new(g.path.clone(), 0.0);
-            for &la in &GREEDY_LOOKAHEADS_UNITS {
-                if budget.expired() {
-                    break 'sweep;
-                }
-                let guide = GreedyGuide {
-                    clearance_units: g.clearance_units,
-                    centre_line: g.centre_line,
-                    lookahead_units: la,
-                    speed_cap_ups: cap,
-                    corner_bend_units,
-                    sharp_turns,
-                };
-                let run = sim.run_summary_broken_until(
-                    &mut strafer(&g.path, &guide, corners.as_ref()),
-                    budget,
-                    broken_frame_limit,
-                );
-                let t = match (run.feasible(), run.crossing) {
-                    (true, Some(c)) => c.time,
-                    _ => f64::INFINITY,
-                };
-                if t.is_finite() {
-                    if run.collisions == 0 && best_clean.as_ref().is_none_or(|b| t < b.0) {
-                        best_clean = Some((t, i, guide));
-                    }
-                    if best_valid.as_ref().is_none_or(|b| t < b.0) {
-                        best_valid = Some((t, i, guide));
-                    }
-                } else if runs.valid.is_empty() && best_valid.is_none() {
-                    let r = match run.crossing {
-                        Some(c) => (1, c.time),
-                        None => (2, -along.project(run.end_pos)),
-                    };
-                    if runs.fallback.as_ref().is_none_or(|b| r < b.0) {
-                        runs.fallback = Some((r, i, guide));
-                    }
-                }
-            }
-            runs.clean.extend(best_clean);
-            runs.valid.extend(best_valid);
+    // Speed-limited runs along the shortest path and the widest guide only: the limits are for corners
+    // the uncapped strafer overshoots, and every guide in between would multiply the runs. Sharp turns
+    // keep the speed, so the guide they follow matters as much as the plain strafer's.
+    let last = guides.len() - 1;
+    let jobs: Vec<(Option<Cornering>, usize)> = first
+        .into_iter()
+        .chain(cornering.iter().copied().map(Some))
+        .flat_map(|way| {
+            let limited = matches!(way, Some(Cornering::Cap(_) | Cornering::CornerSpeeds(_)));
+            (0..guides.len())
+                .filter(move |&i| !limited || i == 0 || i == last)
+                .map(move |i| (way, i))
+        })
+        .collect();
+    let swept = side_by_side(&jobs, |&(way, i)| {
+        sweep_guide(sim, guides, way, i, broken_frame_limit, budget)
+    });
+    for guide in swept {
+        if guide.cut {
+            break;
         }
+        if runs.valid.is_empty() {
+            if let Some(f) = guide.fallback {
+                if runs.fallback.as_ref().is_none_or(|b| f.0 < b.0) {
+                    runs.fallback = Some(f);
+                }
+            }
+        }
+        runs.clean.extend(guide.clean);
+        runs.valid.extend(guide.valid);
     }
     runs.valid.sort_by(|a, b| a.0.total_cmp(&b.0));
     runs.clean.sort_by(|a, b| a.0.total_cmp(&b.0));
+}
+
+/// `f` of each of `jobs`, on as many threads as the machine has cores, in the order of `jobs`.
+fn side_by_side<J: Sync, R: Send>(jobs: &[J], f: impl Fn(&J) -> R + Sync) -> Vec<R> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(jobs.len());
+    if threads <= 1 {
+        return jobs.iter().map(f).collect();
+    }
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut done: Vec<(usize, R)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = Vec::new();
+                    loop {
+                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(job) = jobs.get(k) else {
+                            break mine;
+                        };
+                        mine.push((k, f(job)));
+                    }
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| {
+                w.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
+            .collect()
+    });
+    done.sort_by_key(|(k, _)| *k);
+    done.into_iter().map(|(_, r)| r).collect()
+}
+
+/// One guide's runs at every look-ahead in one way of cornering.
+struct GuideSweep {
+    /// The fastest clean run.
+    clean: Option<(f64, usize, GreedyGuide)>,
+    /// The fastest valid run.
+    valid: Option<(f64, usize, GreedyGuide)>,
+    /// The best-ranked invalid run before the first valid one: by crossing time, else by how far it got.
+    fallback: Option<((u8, f64), usize, GreedyGuide)>,
+    /// Whether the budget ran out before every look-ahead was played.
+    cut: bool,
+}
+
+/// Guide `i` played at every look-ahead in `way` of cornering (plain when `None`), for its verdicts.
+fn sweep_guide(
+    sim: &Simulation,
+    guides: &[GuidePath],
+    way: Option<Cornering>,
+    i: usize,
+    broken_frame_limit: u64,
+    budget: &Budget,
+) -> GuideSweep {
+    let (cap, corner_bend_units, sharp_turns) = match way {
+        None => (None, None, false),
+        Some(Cornering::Cap(cap)) => (Some(cap), None, false),
+        Some(Cornering::CornerSpeeds(w)) => (None, Some(w), false),
+        Some(Cornering::SharpTurns) => (None, None, true),
+    };
+    let g = &guides[i];
+    // The corner speeds along this guide, the same at every look-ahead.
+    let corners = corner_bend_units.map(|w| corner_speeds(sim.scene(), &g.path, w));
+    let mut swept = GuideSweep {
+        clean: None,
+        valid: None,
+        fallback: None,
+        cut: false,
+    };
+    // Ranks how far along this guide an unfinished run got.
+    let along = Greedy::new(g.path.clone(), 0.0);
+    for &la in &GREEDY_LOOKAHEADS_UNITS {
+        if budget.expired() {
+            swept.cut = true;
+            break;
+        }
+        let guide = GreedyGuide {
+            clearance_units: g.clearance_units,
+            centre_line: g.centre_line,
+            lookahead_units: la,
+            speed_cap_ups: cap,
+            corner_bend_units,
+            sharp_turns,
+        };
+        let run = sim.run_summary_broken_until(
+            &mut strafer(&g.path, &guide, corners.as_ref()),
+            budget,
+            broken_frame_limit,
+        );
+        let t = match (run.feasible(), run.crossing) {
+            (true, Some(c)) => c.time,
+            _ => f64::INFINITY,
+        };
+        if t.is_finite() {
+            if run.collisions == 0 && swept.clean.as_ref().is_none_or(|b| t < b.0) {
+                swept.clean = Some((t, i, guide));
+            }
+            if swept.valid.as_ref().is_none_or(|b| t < b.0) {
+                swept.valid = Some((t, i, guide));
+            }
+        } else if swept.valid.is_none() {
+            let r = match run.crossing {
+                Some(c) => (1, c.time),
+                None => (2, -along.project(run.end_pos)),
+            };
+            if swept.fallback.as_ref().is_none_or(|b| r < b.0) {
+                swept.fallback = Some((r, i, guide));
+            }
+        }
+    }
+    swept
 }
 
 /// The baseline run picked from `runs`, and whether its engine-exact replay is valid.
@@ -576,6 +661,23 @@ mod tests {
     use crate::optimise::planner::{
         fast_hairpin_at_air_acceleration_100, planning_inputs, staircase_scene,
     };
+
+    #[test]
+    fn jobs_played_side_by_side_come_back_in_the_order_of_the_jobs() {
+        // The early jobs are the slow ones, so the threads finish them last.
+        let jobs: Vec<u64> = (0..40).collect();
+        let work = |&j: &u64| -> u64 {
+            let mut x = j;
+            for _ in 0..(40 - j) * 20_000 {
+                x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+            }
+            j * 1000 + x % 1000
+        };
+        let one_after_the_other: Vec<u64> = jobs.iter().map(work).collect();
+        assert_eq!(side_by_side(&jobs, work), one_after_the_other);
+        assert_eq!(side_by_side(&jobs[..1], work), one_after_the_other[..1]);
+        assert!(side_by_side(&jobs[..0], work).is_empty());
+    }
 
     #[test]
     fn a_corner_wrapped_by_several_vertices_counts_as_one_turn() {
