@@ -303,6 +303,9 @@ pub struct ScpSolver<'c> {
     stats: SearchStats,
     /// Dynamics duals of the last solved sub-problem, per frame: the curvature weights.
     duals: Option<Vec<[f64; 4]>>,
+    /// The share of the Lagrangian's curvature the sub-problems carry, in `[MIN_CURVATURE_SHARE, 1]`
+    /// (see [`OVERCURVED_RATIO`]).
+    curvature_share: f64,
     /// The cost after each iteration so far.
     costs: Vec<f64>,
     /// The stage's iteration cap (the stall test weighs the iterations left).
@@ -319,9 +322,21 @@ impl<'c> ScpSolver<'c> {
             converged: false,
             stats: SearchStats::default(),
             duals: None,
+            curvature_share: 1.0,
             costs: Vec::new(),
             max_iters: u64::MAX,
         }
+    }
+}
+
+/// The curvature's share after a step that gained `ratio` times its prediction (`None`: rejected): halved
+/// above [`OVERCURVED_RATIO`], doubled below [`UNDERCURVED_RATIO`] or after a rejection, within
+/// `[MIN_CURVATURE_SHARE, 1]`.
+fn next_curvature_share(share: f64, ratio: Option<f64>) -> f64 {
+    match ratio {
+        Some(r) if r > OVERCURVED_RATIO => (0.5 * share).max(MIN_CURVATURE_SHARE),
+        Some(r) if r >= UNDERCURVED_RATIO => share,
+        _ => (2.0 * share).min(1.0),
     }
 }
 
@@ -355,6 +370,20 @@ const STALL_WINDOW: usize = 10;
 /// Least share of the predicted gain a step must deliver to be accepted.
 const ACCEPT_RATIO: f64 = 0.1;
 
+/// A step that gains more than this many times its prediction halves the share of the curvature the
+/// next sub-problems carry. Each frame's block of the Lagrangian's Hessian has its negative part cut off
+/// ([`super::lagrangian::convexify`]), so wherever neighbouring blocks' curvatures cancel the model is
+/// more curved than the merit, and its step stops short of a gain that is there: a step interior to the
+/// trust region that gains twice its prediction is the sign (the merit was about linear along it).
+const OVERCURVED_RATIO: f64 = 1.5;
+
+/// A step that gains less than this share of its prediction (or is rejected) doubles the curvature's
+/// share back, up to the whole curvature.
+const UNDERCURVED_RATIO: f64 = 0.75;
+
+/// The least share of the curvature the sub-problems carry.
+const MIN_CURVATURE_SHARE: f64 = 1.0 / 64.0;
+
 impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
     fn name(&self) -> &str {
         "scp-clarabel"
@@ -386,7 +415,14 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let controls = unpack(&param);
         let trust = self.trust;
         let upper_at_kink = state.get_iter() % 2 == 0;
-        let duals = self.duals.take();
+        // The curvature is linear in the duals, and so is its convexification: scaling the duals scales
+        // the model's curvature.
+        let share = self.curvature_share;
+        let duals = self.duals.take().map(|z| {
+            z.into_iter()
+                .map(|zk| zk.map(|v| v * share))
+                .collect::<Vec<_>>()
+        });
         let seconds_left = self
             .budget
             .remaining()
@@ -425,7 +461,9 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let new_cost = problem.cost(&candidate).unwrap_or(f64::INFINITY);
         let actual = cost - new_cost;
         let ratio = actual / step.predicted;
-        if actual > 0.0 && ratio >= ACCEPT_RATIO {
+        let accepted = actual > 0.0 && ratio >= ACCEPT_RATIO;
+        if accepted {
+            self.curvature_share = next_curvature_share(self.curvature_share, Some(ratio));
             if ratio > 0.75 {
                 self.trust = (self.trust * 2.0).min(4.0);
             } else if ratio < 0.25 {
@@ -448,6 +486,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
                 }
             }
             self.stats.rejected_steps += 1;
+            self.curvature_share = next_curvature_share(self.curvature_share, None);
             self.trust *= 0.3;
             Ok((state, None))
         }
@@ -621,6 +660,30 @@ pub(super) fn model_crossing(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_curvature_share_halves_after_steps_gaining_twice_their_prediction_and_comes_back_after_poor_ones(
+    ) {
+        // A step gaining twice its prediction: the merit was about linear along it. The shares are powers
+        // of two, so they compare exactly.
+        let mut share = 1.0;
+        let halved: Vec<f64> = (0..8)
+            .map(|_| {
+                share = next_curvature_share(share, Some(2.0));
+                share
+            })
+            .collect();
+        let floor = MIN_CURVATURE_SHARE;
+        assert_eq!(
+            halved,
+            [0.5, 0.25, 0.125, 0.0625, 0.03125, floor, floor, floor]
+        );
+        // A step the model predicted well keeps the share; a poor or rejected one doubles it back.
+        assert_eq!(next_curvature_share(0.25, Some(1.0)), 0.25);
+        assert_eq!(next_curvature_share(0.25, Some(0.5)), 0.5);
+        assert_eq!(next_curvature_share(0.25, None), 0.5);
+        assert_eq!(next_curvature_share(1.0, None), 1.0);
+    }
 
     fn solver_with(costs: &[f64], max_iters: u64) -> ScpSolver<'static> {
         let mut s = ScpSolver::new(1e-6, Budget::unlimited());
