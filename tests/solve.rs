@@ -324,6 +324,36 @@ fn a_line_refined_at_the_tight_margin_reaches_the_certificate_frame() {
     );
 }
 
+#[test]
+fn a_line_refined_at_a_wider_margin_steps_out_to_it_rather_than_stopping_inside() {
+    // Generated scene 23 of seed 97 (CI-sized family: 100 fps, air acceleration 10, 708 ups into two
+    // turns of a corridor 66 units wide): the relaxed stage stops at 391 frames, a greedy start of the
+    // certificate reaches 354. That line, refined at the planning margin to be rounded, starts inside the
+    // margin; its sub-problems, moving frames back out to it, predicted a loss, the stages stopped there
+    // unclear, the refinement found nothing and the plan crossed in frame 390. Stepping out first, the
+    // line is refined and rounded, and the plan crosses in its certificate's frame.
+    let (plan, r) = ci_sized_plan_and_certificate(97, 23);
+    assert_eq!(
+        (plan.frames, r.frames),
+        (354, 354),
+        "{plan:?} against {r:?}"
+    );
+}
+
+#[test]
+fn sub_problems_carrying_the_share_of_curvature_the_steps_bear_out_reach_the_certificate_frame() {
+    // Generated scene 28 of seed 97 (CI-sized family: 100 fps, air acceleration 10): with the whole
+    // convexified curvature in every sub-problem (each frame's block cut to positive semidefinite, more
+    // curved than the merit where neighbouring blocks cancel) the plan crossed in frame 145, a frame
+    // behind its certificate; with the share of it that the steps bear out, in frame 144.
+    let (plan, r) = ci_sized_plan_and_certificate(97, 28);
+    assert_eq!(
+        (plan.frames, r.frames),
+        (144, 144),
+        "{plan:?} against {r:?}"
+    );
+}
+
 /// Scene `index` of `seed` of the CI-sized generated family solved at `fast`: the plan's crossing and
 /// the certificate, once the plan is checked valid in f64 and engine-exact.
 fn ci_sized_plan_and_certificate(

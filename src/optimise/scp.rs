@@ -306,6 +306,9 @@ pub struct ScpSolver<'c> {
     /// The share of the Lagrangian's curvature the sub-problems carry, in `[MIN_CURVATURE_SHARE, 1]`
     /// (see [`OVERCURVED_RATIO`]).
     curvature_share: f64,
+    /// Whether the last step taken was a restoration ([`ScpSolver::restoration`]): not taken again in a row,
+    /// only after an ordinary step is accepted.
+    restored_last: bool,
     /// The cost after each iteration so far.
     costs: Vec<f64>,
     /// The stage's iteration cap (the stall test weighs the iterations left).
@@ -323,6 +326,7 @@ impl<'c> ScpSolver<'c> {
             stats: SearchStats::default(),
             duals: None,
             curvature_share: 1.0,
+            restored_last: false,
             costs: Vec::new(),
             max_iters: u64::MAX,
         }
@@ -380,6 +384,9 @@ const OVERCURVED_RATIO: f64 = 1.5;
 /// A step that gains less than this share of its prediction (or is rejected) doubles the curvature's
 /// share back, up to the whole curvature.
 const UNDERCURVED_RATIO: f64 = 0.75;
+
+/// A restoration step ([`ScpSolver::restoration`]) may lose at most this many times its predicted loss.
+const RESTORATION_LOSS_FACTOR: f64 = 2.0;
 
 /// The least share of the curvature the sub-problems carry.
 const MIN_CURVATURE_SHARE: f64 = 1.0 / 64.0;
@@ -451,8 +458,17 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         };
         // No gain in the merit by the model: converged. The prediction can be negative: the sub-problem
         // also asks moves inside the wall margin back out to it, which the merit (it counts only what is
-        // closer than the accepted clearance) does not pay for.
+        // closer than the accepted clearance) does not pay for. A plan closer to a wall than that would
+        // end unclean, of no use to a count search, so its step out is taken first.
         if step.predicted <= self.tol {
+            if step.predicted < -self.tol && !self.restored_last {
+                if let Some((restored, restored_cost)) =
+                    self.restoration(problem, &controls, &du, cost, step.predicted)?
+                {
+                    self.restored_last = true;
+                    return Ok((state.param(restored).cost(restored_cost), None));
+                }
+            }
             self.converged = true;
             return Ok((state, None));
         }
@@ -464,6 +480,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let accepted = actual > 0.0 && ratio >= ACCEPT_RATIO;
         if accepted {
             self.curvature_share = next_curvature_share(self.curvature_share, Some(ratio));
+            self.restored_last = false;
             if ratio > 0.75 {
                 self.trust = (self.trust * 2.0).min(4.0);
             } else if ratio < 0.25 {
@@ -557,6 +574,36 @@ impl ScpSolver<'_> {
         // A plan whose trajectory is not finite is simply worse than any finite one.
         let corrected_cost = problem.cost(&corrected).unwrap_or(f64::INFINITY);
         Ok(Some((corrected, corrected_cost)))
+    }
+
+    /// The restoration of a plan that is not clear: where the sub-problem predicts a loss (`predicted`,
+    /// negative), it moved frames inside the wall margin back out to it. If the plan (cost `cost`) comes
+    /// closer to a wall than the merit accepts, that step `du` is taken, as long as it loses at most
+    /// [`RESTORATION_LOSS_FACTOR`] times the predicted loss; else `None` (the stage converged). Without
+    /// it a line solved at a smaller margin and refined at a wider one (the certificate's line, rounded)
+    /// could stop inside the wider margin after a few iterations, and its count search give it up.
+    fn restoration(
+        &self,
+        problem: &mut Problem<ScpProblem<'_>>,
+        controls: &[FrameControl],
+        du: &[(f64, f64)],
+        cost: f64,
+        predicted: f64,
+    ) -> std::result::Result<Option<(Vec<f64>, f64)>, ArgminError> {
+        let unclear = problem.problem("restore", |pr| {
+            let states = rollout_knots(&pr.start, controls, &pr.fl, pr.frames_per_knot);
+            Ok(pr.violation(&states) > CLEAN_VIOLATION_UNITS)
+        })?;
+        if !unclear {
+            return Ok(None);
+        }
+        let restored = stepped(controls, du);
+        // A plan whose trajectory is not finite is simply worse than any finite one.
+        let restored_cost = problem.cost(&restored).unwrap_or(f64::INFINITY);
+        Ok(
+            (cost - restored_cost >= RESTORATION_LOSS_FACTOR * predicted)
+                .then_some((restored, restored_cost)),
+        )
     }
 
     /// Whether a plan short of the line (`cost > 0`: the merit is the progress past it) cannot reach it
