@@ -9,7 +9,10 @@
 //! From the second iteration on, the sub-step also carries the curvature of the Lagrangian, weighted by
 //! the last sub-step's dynamics duals and convexified ([`super::lagrangian`]): a sequential quadratic
 //! program. Its model is right to second order, so its steps stay long along a line of hundreds of frames
-//! where a linear model's trust region would shrink to nothing.
+//! where a linear model's trust region would shrink to nothing. The convexified curvature can be more
+//! curved than the merit, so each stage carries a share of it that follows how far its steps outdo their
+//! predictions (`OVERCURVED_RATIO`); and a plan left closer to a wall than the merit accepts takes its
+//! step back out to the margin before the stage may end (`ScpSolver::restoration`).
 
 use super::lagrangian::{convexify, lagrangian_block, CurvatureBlock};
 use super::model::{knot, knot_hessian, rollout_knots, FrameControl, FrameLaw, ModelState};
