@@ -18,5 +18,6 @@ pub mod report;
 pub mod scene;
 pub mod serve;
 pub mod sim;
+pub mod work;
 
 pub use error::{Error, Result};

@@ -21,8 +21,6 @@ use crate::scene::{self, Expectation, ExpectedRun, Limits, Scene};
 use crate::sim::controllers::{best_greedy, best_sharp_turning_greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{SideStrafer, Simulation};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 use std::time::Instant;
 
 /// The figures of one run that an expectation can check.
@@ -271,45 +269,15 @@ pub fn run(
     on_event: &(dyn Fn(CheckEvent<'_>) + Sync),
 ) -> CheckReport {
     let started = Instant::now();
-    let next = AtomicUsize::new(0);
-    let slots: Mutex<Vec<Option<SceneCheck>>> = Mutex::new(vec![None; files.len()]);
-    let worker = || loop {
-        let index = next.fetch_add(1, Ordering::Relaxed);
-        let Some(path) = files.get(index) else { break };
+    let scenes = crate::work::in_job_order(files, options.jobs, |index, path| {
         on_event(CheckEvent::Started { index, path });
         let check = check_scene(path, options.update);
         on_event(CheckEvent::Finished {
             index,
             check: &check,
         });
-        // A panicking worker poisons the lock; the others' results are still whole.
-        let mut slots = slots.lock().unwrap_or_else(|p| p.into_inner());
-        slots[index] = Some(check);
-    };
-    let threads = options.jobs.clamp(1, files.len().max(1));
-    std::thread::scope(|s| {
-        for _ in 1..threads {
-            s.spawn(worker);
-        }
-        worker();
+        check
     });
-    let scenes = slots
-        .into_inner()
-        .unwrap_or_else(|p| p.into_inner())
-        .into_iter()
-        .zip(files)
-        .map(|(check, path)| {
-            check.unwrap_or_else(|| SceneCheck {
-                path: path.clone(),
-                run: None,
-                measured: None,
-                refusal: None,
-                verdict: Verdict::Error("the check of this scene panicked".to_string()),
-                update: None,
-                seconds: 0.0,
-            })
-        })
-        .collect();
     CheckReport {
         scenes,
         seconds: started.elapsed().as_secs_f64(),

@@ -31,10 +31,7 @@ pub fn run(args: &CheckArgs) -> Result<(String, u8)> {
     if files.is_empty() {
         return Err(nothing_to_check(&paths));
     }
-    let jobs = args.jobs.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        usize::from,
-    );
+    let jobs = args.jobs.map_or_else(crate::work::cores, usize::from);
     let options = CheckOptions {
         jobs,
         update: args.update,

@@ -427,7 +427,7 @@ fn replay(sim: &Simulation, guides: &[GuidePath], i: usize, guide: GreedyGuide) 
 
 /// Plays every guide at every look-ahead, plain first when `uncapped`, then each way of `cornering`, for
 /// their verdicts only, into `runs` (kept sorted fastest first). The guides are played side by side on
-/// the machine's cores and their verdicts gathered in the order of the sweep, so the runs kept are those
+/// the machine's cores ([`crate::work::in_job_order`]) and their verdicts gathered in the order of the sweep, so the runs kept are those
 /// of playing them one after the other.
 fn sweep_guides(
     sim: &Simulation,
@@ -453,7 +453,7 @@ fn sweep_guides(
                 .map(move |i| (way, i))
         })
         .collect();
-    let swept = side_by_side(&jobs, |&(way, i)| {
+    let swept = crate::work::in_job_order(&jobs, crate::work::cores(), |_, &(way, i)| {
         sweep_guide(sim, guides, way, i, broken_frame_limit, budget)
     });
     for guide in swept {
@@ -472,42 +472,6 @@ fn sweep_guides(
     }
     runs.valid.sort_by(|a, b| a.0.total_cmp(&b.0));
     runs.clean.sort_by(|a, b| a.0.total_cmp(&b.0));
-}
-
-/// `f` of each of `jobs`, on as many threads as the machine has cores, in the order of `jobs`.
-fn side_by_side<J: Sync, R: Send>(jobs: &[J], f: impl Fn(&J) -> R + Sync) -> Vec<R> {
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(jobs.len());
-    if threads <= 1 {
-        return jobs.iter().map(f).collect();
-    }
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut done: Vec<(usize, R)> = std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(job) = jobs.get(k) else {
-                            break mine;
-                        };
-                        mine.push((k, f(job)));
-                    }
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|w| {
-                w.join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-            })
-            .collect()
-    });
-    done.sort_by_key(|(k, _)| *k);
-    done.into_iter().map(|(_, r)| r).collect()
 }
 
 /// One guide's runs at every look-ahead in one way of cornering.
@@ -661,23 +625,6 @@ mod tests {
     use crate::optimise::planner::{
         fast_hairpin_at_air_acceleration_100, planning_inputs, staircase_scene,
     };
-
-    #[test]
-    fn jobs_played_side_by_side_come_back_in_the_order_of_the_jobs() {
-        // The early jobs are the slow ones, so the threads finish them last.
-        let jobs: Vec<u64> = (0..40).collect();
-        let work = |&j: &u64| -> u64 {
-            let mut x = j;
-            for _ in 0..(40 - j) * 20_000 {
-                x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
-            }
-            j * 1000 + x % 1000
-        };
-        let one_after_the_other: Vec<u64> = jobs.iter().map(work).collect();
-        assert_eq!(side_by_side(&jobs, work), one_after_the_other);
-        assert_eq!(side_by_side(&jobs[..1], work), one_after_the_other[..1]);
-        assert!(side_by_side(&jobs[..0], work).is_empty());
-    }
 
     #[test]
     fn a_corner_wrapped_by_several_vertices_counts_as_one_turn() {
