@@ -25,24 +25,27 @@ pub fn run(args: &SimulateArgs) -> Result<String> {
         la => la,
     };
     let (trace, lookahead) = match args.controller {
-        ControllerArg::Greedy => match lookahead {
-            Some(la) => (sim.run(&mut Greedy::new(bound.path.clone(), la)), Some(la)),
-            None => {
-                let (t, la) = best_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS);
-                (t, Some(la))
+        ControllerArg::Greedy | ControllerArg::SharpTurns => {
+            let sharp = matches!(args.controller, ControllerArg::SharpTurns);
+            match lookahead {
+                Some(la) => {
+                    let mut strafer = Greedy::new(bound.path.clone(), la);
+                    if sharp {
+                        strafer = strafer.with_sharp_turns();
+                    }
+                    (sim.run(&mut strafer), Some(la))
+                }
+                None => {
+                    let best = if sharp {
+                        best_sharp_turning_greedy
+                    } else {
+                        best_greedy
+                    };
+                    let (t, la) = best(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS);
+                    (t, Some(la))
+                }
             }
-        },
-        ControllerArg::SharpTurns => match lookahead {
-            Some(la) => {
-                let mut strafer = Greedy::new(bound.path.clone(), la).with_sharp_turns();
-                (sim.run(&mut strafer), Some(la))
-            }
-            None => {
-                let (t, la) =
-                    best_sharp_turning_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS);
-                (t, Some(la))
-            }
-        },
+        }
         ControllerArg::MaxAccelLeft => (sim.run(&mut SideStrafer { side: Side::Left }), None),
         ControllerArg::MaxAccelRight => (sim.run(&mut SideStrafer { side: Side::Right }), None),
         ControllerArg::Abh => (sim.run(&mut crate::sim::abh::Abh::default()), None),
