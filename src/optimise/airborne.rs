@@ -58,10 +58,24 @@ impl LineMargins {
 struct Source {
     line: Vec<FrameControl>,
     margin: f64,
-    /// Whether the line is the planning margin's: where none of its plans stays valid, it is re-solved
-    /// wider and the final margin widened. The tight line's plans only add candidates: at a wider margin
-    /// it would be the planning line again.
-    planning: bool,
+    widening: Widening,
+}
+
+/// What is widened where none of a line's plans rounded at the first horizon stays valid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Widening {
+    /// Nothing: the tight line, whose plans only add candidates (at a wider margin it would be the
+    /// planning line again).
+    None,
+    /// The final margin ([`FINAL_MARGIN_FACTORS`]): a certificate's line beside a valid plan. Its plans
+    /// only add candidates too, but a plan valid in the model can scrape a wall once its yaws are
+    /// quantised, and a wider final margin is a polish more; re-solving the line wider is a relaxed stage
+    /// and a polish over every frame for each margin, and on long runs took most of the solve.
+    FinalMargin,
+    /// The final margin and, where a rounding leaves the walls, the line re-solved wider
+    /// ([`MARGIN_RETRIES`]): the line a plan must come from (the relaxed stage's at the planning margin,
+    /// or a certificate's while there is no plan).
+    FinalMarginAndLine,
 }
 
 /// The fastest valid exact plan so far: its crossing time (seconds) and its f64 trace (the plan as
@@ -97,7 +111,7 @@ pub(super) fn plan_airborne(
         lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress)
     });
     // Without a relaxed line there is no plan for a certificate to be beside.
-    let Some((mut certifier, mut best)) = mine else {
+    let Some((mut certifier, mut best, relaxed_line_frame)) = mine else {
         return AirbornePlan {
             best: None,
             certifier: Certifier::default(),
@@ -107,12 +121,17 @@ pub(super) fn plan_airborne(
     for side_certifier in side_certifiers {
         certifier.absorb(side_certifier);
     }
-    // A greedy start whose relaxed line is faster than the relaxed plan's (by more than the stages can
-    // tell apart): its line is rounded too.
+    // A line of the certificate's problem that is another optimum than the relaxed stage's (a greedy
+    // start's, faster by more than the stages can tell apart, or any start's crossing a frame or more
+    // before the fastest plan, or the relaxed line where there is no plan): it is rounded too.
     let same_optimum_s = certifier
         .best()
         .map_or(0.0, |p| same_optimum_s(planner, &p.controls));
-    if let Some(plan) = certifier.ahead_of_the_first(same_optimum_s) {
+    let frame_to_beat = best
+        .as_ref()
+        .and_then(|(_, trace)| trace.crossing.map(|c| c.frames))
+        .unwrap_or(relaxed_line_frame);
+    if let Some(plan) = certifier.another_optimum(same_optimum_s, frame_to_beat) {
         let line = plan.controls.clone();
         plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, &mut best);
     }
@@ -154,20 +173,24 @@ fn plans_of_certificate_line(
     progress: &mut dyn FnMut(Progress),
     best: &mut BestPlan,
 ) {
-    if let Some(source) = refined(planner, progress, line, lo, margins.planning, true) {
+    let widening = match best {
+        Some(_) => Widening::FinalMargin,
+        None => Widening::FinalMarginAndLine,
+    };
+    if let Some(source) = refined(planner, progress, line, lo, margins.planning, widening) {
         exact_plans(planner, &source, greedy_s, best);
     }
 }
 
-/// `line` refined by the count search at `margin` (units), frame by frame, as a line to round (`planning`:
-/// whether it is at the planning margin, see [`Source::planning`]); `None` if it no longer reaches the line.
+/// `line` refined by the count search at `margin` (units), frame by frame, as a line to round with
+/// `widening`; `None` if it no longer reaches the line.
 fn refined(
     planner: &mut Planner,
     progress: &mut dyn FnMut(Progress),
     line: Vec<FrameControl>,
     lo: usize,
     margin: f64,
-    planning: bool,
+    widening: Widening,
 ) -> Option<Source> {
     let n = line.len();
     let search = CountSearch::per_frame(Relaxation::planning(margin));
@@ -175,7 +198,7 @@ fn refined(
     Some(Source {
         line,
         margin,
-        planning,
+        widening,
     })
 }
 
@@ -231,8 +254,8 @@ fn certified_greedy_starts(
     certifier
 }
 
-/// The relaxed line, the certificate's start from it, the tight line, and the exact plans of both lines;
-/// `None` when the relaxed stage found no line. The certificate's start from the relaxed line is solved
+/// The relaxed line, the certificate's start from it, the tight line, and the exact plans of both lines,
+/// with the frame the relaxed line crosses in; `None` when the relaxed stage found no line. The certificate's start from the relaxed line is solved
 /// on a fork beside the tight line and the exact plans: both begin at the relaxed line and neither needs
 /// the other.
 fn lines_and_plans(
@@ -243,7 +266,7 @@ fn lines_and_plans(
     margins: LineMargins,
     greedy_s: f64,
     progress: &mut dyn FnMut(Progress),
-) -> Option<(Certifier, BestPlan)> {
+) -> Option<(Certifier, BestPlan, u64)> {
     let relaxed = relaxed_plan(
         planner,
         progress,
@@ -254,6 +277,7 @@ fn lines_and_plans(
         Descent::PLAN,
     )
     .line?;
+    let relaxed_line_frame = planner.crossing_of(&relaxed).map_or(u64::MAX, |c| c.frames);
     let start = relaxed.clone();
     let certify = move |fork: &mut Planner| {
         let mut certifier = Certifier::default();
@@ -264,7 +288,7 @@ fn lines_and_plans(
         exact_plans_of_both_lines(planner, relaxed, lo, margins, greedy_s, progress)
     });
     let certifier = certifiers.into_iter().next().unwrap_or_default();
-    Some((certifier, best))
+    Some((certifier, best, relaxed_line_frame))
 }
 
 /// The tight line refined from the relaxed one, and the exact plans of both lines.
@@ -279,10 +303,17 @@ fn exact_plans_of_both_lines(
     let mut sources = vec![Source {
         line: relaxed.clone(),
         margin: margins.planning,
-        planning: true,
+        widening: Widening::FinalMarginAndLine,
     }];
     if let Some(tight) = margins.tight {
-        sources.extend(refined(planner, progress, relaxed, lo, tight, false));
+        sources.extend(refined(
+            planner,
+            progress,
+            relaxed,
+            lo,
+            tight,
+            Widening::None,
+        ));
     }
     progress(Progress::Finishing);
     let mut best = None;
@@ -293,15 +324,15 @@ fn exact_plans_of_both_lines(
 }
 
 /// Stages 3 and 4 for one relaxed line: rounded, polished, quantised and verified, first at the settings'
-/// final margin; for the planning line, if no plan rounded at the first horizon stays valid (a tight
-/// margin along a long wall), again at wider ones. A plan replaces `best` when it is faster (and faster
-/// than `greedy_s`).
+/// final margin; if no plan rounded at the first horizon stays valid (a tight margin along a long wall),
+/// again as the line's [`Widening`] allows. A plan replaces `best` when it is faster (and faster than
+/// `greedy_s`).
 fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut BestPlan) {
     let final_margin_units = planner.settings.margin_units;
-    let (factors, margin_retries) = if source.planning {
-        (&FINAL_MARGIN_FACTORS[..], MARGIN_RETRIES)
-    } else {
-        (&FINAL_MARGIN_FACTORS[..1], 0)
+    let (factors, margin_retries) = match source.widening {
+        Widening::None => (&FINAL_MARGIN_FACTORS[..1], 0),
+        Widening::FinalMargin => (&FINAL_MARGIN_FACTORS[..], 0),
+        Widening::FinalMarginAndLine => (&FINAL_MARGIN_FACTORS[..], MARGIN_RETRIES),
     };
     for final_margin in factors.iter().map(|f| f * final_margin_units) {
         let mut valid = false;

@@ -480,14 +480,23 @@ impl Certifier {
         self.best.as_ref()
     }
 
-    /// The fastest relaxed plan, if a start after the first found it more than `same_optimum_s` seconds
-    /// before the first start's line (or the first reached nothing): another local optimum than the
-    /// first start's, not the same one found again to within the stages' tolerance.
-    pub(super) fn ahead_of_the_first(&self, same_optimum_s: f64) -> Option<&CertifiedPlan> {
-        let best = self.best.as_ref().filter(|b| b.start_index > 0)?;
+    /// The fastest relaxed plan, if it is another local optimum than the line the relaxed stage rounded:
+    /// a start after the first found it more than `same_optimum_s` seconds before the first start's line
+    /// (or the first reached nothing), not the same optimum found again to within the stages' tolerance;
+    /// or it crosses before frame `frame_to_beat` (the fastest exact plan's, or the relaxed stage's line's
+    /// where there is none), whichever start found it: the relaxed stage, at the planning margin, can stop
+    /// short of an optimum that the certificate's problem, descending from its line, goes on to.
+    pub(super) fn another_optimum(
+        &self,
+        same_optimum_s: f64,
+        frame_to_beat: u64,
+    ) -> Option<&CertifiedPlan> {
+        let best = self.best.as_ref()?;
+        if best.crossing.frames < frame_to_beat {
+            return Some(best);
+        }
         let first = self.ends.iter().find(|e| e.index == 0).map(|e| e.time);
-        first
-            .is_none_or(|t| best.crossing.time < t - same_optimum_s)
+        (best.start_index > 0 && first.is_none_or(|t| best.crossing.time < t - same_optimum_s))
             .then_some(best)
     }
 
@@ -581,14 +590,13 @@ mod tests {
     #[test]
     fn a_later_start_is_another_line_only_when_ahead_of_the_first_by_more_than_the_tolerance() {
         // Through frame 100 at 100 fps: the first start at 0.5 of the frame, the second 1e-5 of a frame
-        // (1e-7 s) before it.
+        // (1e-7 s) before it; the frame to beat is the same.
         let c = certifier_of(2, &[0.5, 0.5 - 1e-5], 1);
-        assert!(c.ahead_of_the_first(1e-6).is_none());
-        assert_eq!(c.ahead_of_the_first(1e-8).map(|b| b.start_index), Some(1));
-        // The first start's own line is never another.
-        assert!(certifier_of(2, &[0.4, 0.5], 0)
-            .ahead_of_the_first(0.0)
-            .is_none());
+        assert!(c.another_optimum(1e-6, 100).is_none());
+        assert_eq!(c.another_optimum(1e-8, 100).map(|b| b.start_index), Some(1));
+        // The first start's own line is not another while it crosses in the frame to beat.
+        let first_fastest = certifier_of(2, &[0.4, 0.5], 0);
+        assert!(first_fastest.another_optimum(0.0, 100).is_none());
         // Where the first start reached nothing, a later start's line is the only one.
         let mut first_short = Certifier {
             tried: 1,
@@ -596,7 +604,26 @@ mod tests {
         };
         first_short.absorb(certifier_of(1, &[0.5], 0));
         assert_eq!(
-            first_short.ahead_of_the_first(1.0).map(|b| b.start_index),
+            first_short.another_optimum(1.0, 100).map(|b| b.start_index),
+            Some(1)
+        );
+    }
+
+    #[test]
+    fn a_line_a_frame_ahead_of_the_frame_to_beat_is_another_whichever_start_found_it() {
+        // The frame to beat is 101; the certificate's starts cross in frame 100.
+        let first_fastest = certifier_of(2, &[0.4, 0.5], 0);
+        assert_eq!(
+            first_fastest
+                .another_optimum(1.0, 101)
+                .map(|b| b.start_index),
+            Some(0)
+        );
+        let second_fastest = certifier_of(2, &[0.5, 0.5 - 1e-5], 1);
+        assert_eq!(
+            second_fastest
+                .another_optimum(1.0, 101)
+                .map(|b| b.start_index),
             Some(1)
         );
     }
@@ -693,13 +720,13 @@ mod tests {
 
     #[test]
     fn a_greedy_start_whose_knots_reach_no_clean_line_descends_at_the_planning_margin_first() {
-        // Generated scene 5 of seed 81 (CI-sized: 100 fps, air acceleration 10, 336 frames), its second
-        // clean greedy run: averaged over knots of 4 frames it runs into the walls, so the knots reach
-        // nothing and the start descends frame by frame. Measured: at the planning margin first it ends
-        // at the relaxed plan's 336 frames; at the certificate's margin alone its stages stall against
-        // the walls and the search stops short at 352.
+        // Generated scene 23 of seed 97 (CI-sized: 100 fps, air acceleration 10, 66 units wide, a plan
+        // of 354 frames), its second clean greedy run: averaged over knots it runs into the walls, so the
+        // knots reach nothing and the start descends frame by frame. Measured: at the planning margin
+        // first it ends at the plan's 354 frames; at the certificate's margin alone its stages stall
+        // against the walls and the search stops short at 475.
         use crate::scene::generate::{generate, GeneratorSettings};
-        let g = generate(81, 5, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
+        let g = generate(97, 23, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
         let scene = g.scene;
         let (sim, bound, base) = planning_inputs(&scene);
         let settings = SearchSettings::for_quality(Quality::Fast);
@@ -726,9 +753,9 @@ mod tests {
                 let start = warm.clone();
                 line = relaxed_plan(&mut planner, record, start, n, 0, certificate, descent).line;
             });
-            // Knots first (4 frames each): the count search's first count is theirs.
+            // Knots first: the count search's first count is theirs.
             let knot = coarse_knot_frames(n, CoarseRuns::AlsoShort) as usize;
-            assert_eq!(knot, 4);
+            assert!(knot > 1, "{knot}");
             assert!(counts.first().is_some_and(|&c| c % knot == 0), "{counts:?}");
             let frames = line
                 .as_deref()
@@ -736,7 +763,7 @@ mod tests {
                 .map_or(u64::MAX, |c| c.frames);
             ends.push(frames);
         }
-        assert!(ends[0] <= 337, "{ends:?}");
+        assert!(ends[0] <= 355, "{ends:?}");
         assert!(ends[0] + 10 <= ends[1], "{ends:?}");
     }
 

@@ -710,6 +710,46 @@ pub(super) fn model_crossing(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optimise::planner::{planning_inputs, Planner};
+    use crate::optimise::Quality;
+    use crate::scene::generate::{generate, GeneratorSettings};
+
+    #[test]
+    fn a_long_sub_step_ends_where_its_control_changes_take_the_trajectory() {
+        // A 1000 fps corridor of 2,217 frames: Clarabel meets each dynamics row to its tolerance only,
+        // and along the chain those residuals add up to more than a margin's width.
+        let family = GeneratorSettings {
+            fps: vec![1000],
+            max_corners: 2,
+            max_leg_units: 800,
+            ..GeneratorSettings::default()
+        };
+        let scene = generate(61, 5, &family)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .scene;
+        let (sim, bound, base) = planning_inputs(&scene);
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let run = &base.clean[0].trace;
+        let planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
+        let warm = planner.warm_start(run);
+        assert!(warm.len() > 2000, "{} frames", warm.len());
+        let pr = planner.problem(settings.margin_units, true, 1);
+        let lz = pr.linearisation(&warm, None, 1.0, true);
+        let step = qp::solve(&pr.sub_problem(&lz, None));
+        assert!(matches!(step.status, SubStepStatus::Solved { .. }));
+        // The end positions the linearised dynamics give the step's control changes, frame by frame.
+        let mut dx = [0.0; 4];
+        let mut furthest = 0.0_f64;
+        for (k, jac) in lz.lin.jacobians.iter().enumerate() {
+            let du = [step.du[k].0, step.du[k].1];
+            dx = std::array::from_fn(|i| {
+                (0..4).map(|j| jac.a[i][j] * dx[j]).sum::<f64>()
+                    + (0..2).map(|j| jac.b[i][j] * du[j]).sum::<f64>()
+            });
+            furthest = furthest.max((Vec2::new(dx[0], dx[1]) - step.dp[k]).length());
+        }
+        assert!(furthest < 1e-9, "{furthest} units apart");
+    }
 
     #[test]
     fn the_curvature_share_halves_after_steps_gaining_twice_their_prediction_and_comes_back_after_poor_ones(
