@@ -255,9 +255,9 @@ fn certified_greedy_starts(
 }
 
 /// The relaxed line, the certificate's start from it, the tight line, and the exact plans of both lines,
-/// with the frame the relaxed line crosses in; `None` when the relaxed stage found no line. The certificate's start from the relaxed line is solved
-/// on a fork beside the tight line and the exact plans: both begin at the relaxed line and neither needs
-/// the other.
+/// with the frame the relaxed line crosses in; `None` when the relaxed stage found no line. The
+/// certificate's start from the relaxed line is solved on a fork beside the tight line and the exact
+/// plans: both begin at the relaxed line and neither needs the other.
 fn lines_and_plans(
     planner: &mut Planner,
     warm: Vec<FrameControl>,
