@@ -291,8 +291,7 @@ fn a_faster_line_found_from_the_plan_is_rounded_too() {
     // from the relaxed line crosses in frame 97, faster than every start of the certificate; started
     // from that plan, the certificate's problem finds a line of 96 frames, and that line, refined and
     // rounded in turn, gives a plan of 96.
-    let (plan, r) = ci_sized_plan_and_certificate(81, 27);
-    assert_eq!((plan.frames, r.frames), (96, 96), "{plan:?} against {r:?}");
+    assert_ci_sized_plan_in_its_certificate_frame(81, 27, 96);
 }
 
 #[test]
@@ -301,12 +300,7 @@ fn a_rejected_step_whose_wall_rows_are_corrected_keeps_the_descent_going() {
     // second-order correction of rejected steps the count search's steps land in the walls (the model's
     // second-order error along them), the trust region shrinks, and plan and certificate both stop at
     // frame 102; with it both reach 101.
-    let (plan, r) = ci_sized_plan_and_certificate(11, 10);
-    assert_eq!(
-        (plan.frames, r.frames),
-        (101, 101),
-        "{plan:?} against {r:?}"
-    );
+    assert_ci_sized_plan_in_its_certificate_frame(11, 10, 101);
 }
 
 #[test]
@@ -316,12 +310,7 @@ fn a_line_refined_at_the_tight_margin_reaches_the_certificate_frame() {
     // braking frame's push, `tau gamma1`), the plan crossed in frame 310, a frame behind its certificate;
     // the line refined at the tight margin (`tau L`, twice the swing of alternating sides) reaches
     // frame 309.
-    let (plan, r) = ci_sized_plan_and_certificate(71, 12);
-    assert_eq!(
-        (plan.frames, r.frames),
-        (309, 309),
-        "{plan:?} against {r:?}"
-    );
+    assert_ci_sized_plan_in_its_certificate_frame(71, 12, 309);
 }
 
 #[test]
@@ -331,15 +320,9 @@ fn a_certificate_line_ahead_of_the_plan_is_refined_stepping_out_to_its_margin_an
     // from that line itself, reaches 354. That line is rounded too because it crosses frames before
     // the plan (rounded only when a later start was ahead, the plan crossed in frame 361, measured).
     // Refined at the planning margin, it starts inside the margin, and its sub-problems, moving frames
-    // back out to it, predict a loss: without stepping out first, the refinement stopped there unclear
-    // and found nothing (the plan crossed in frame 390 before the steps were judged on their controls'
-    // states, measured).
-    let (plan, r) = ci_sized_plan_and_certificate(97, 23);
-    assert_eq!(
-        (plan.frames, r.frames),
-        (354, 354),
-        "{plan:?} against {r:?}"
-    );
+    // back out to it, predict a loss: without stepping out first, the refinement stops there unclear
+    // and finds nothing, and the plan crosses in frame 361 (measured).
+    assert_ci_sized_plan_in_its_certificate_frame(97, 23, 354);
 }
 
 #[test]
@@ -349,12 +332,7 @@ fn a_certificate_line_beside_a_plan_is_polished_at_a_wider_final_margin_when_its
     // clear in the model, but replayed with quantised yaws they drift 0.2 units and scrape a wall. At
     // three times that margin they stay valid and cross in the certificate's frame (329 without that
     // widening, measured).
-    let (plan, r) = ci_sized_plan_and_certificate(97, 27);
-    assert_eq!(
-        (plan.frames, r.frames),
-        (328, 328),
-        "{plan:?} against {r:?}"
-    );
+    assert_ci_sized_plan_in_its_certificate_frame(97, 27, 328);
 }
 
 #[test]
@@ -363,10 +341,16 @@ fn sub_problems_carrying_the_share_of_curvature_the_steps_bear_out_reach_the_cer
     // convexified curvature in every sub-problem (each frame's block cut to positive semidefinite, more
     // curved than the merit where neighbouring blocks cancel) the plan crossed in frame 145, a frame
     // behind its certificate; with the share of it that the steps bear out, in frame 144.
-    let (plan, r) = ci_sized_plan_and_certificate(97, 28);
+    assert_ci_sized_plan_in_its_certificate_frame(97, 28, 144);
+}
+
+/// Asserts that scene `index` of `seed` of the CI-sized generated family, solved at `fast`, crosses in
+/// frame `frames`, and its certificate too.
+fn assert_ci_sized_plan_in_its_certificate_frame(seed: u64, index: u64, frames: u64) {
+    let (plan, r) = ci_sized_plan_and_certificate(seed, index);
     assert_eq!(
         (plan.frames, r.frames),
-        (144, 144),
+        (frames, frames),
         "{plan:?} against {r:?}"
     );
 }
