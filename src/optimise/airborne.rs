@@ -131,14 +131,29 @@ pub(super) fn plan_airborne(
         .as_ref()
         .and_then(|(_, trace)| trace.crossing.map(|c| c.frames))
         .unwrap_or(relaxed_line_frame);
-    if let Some(plan) = certifier.another_optimum(same_optimum_s, frame_to_beat) {
-        let line = plan.controls.clone();
-        plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, &mut best);
-    }
     // Descending from the plan, the certificate's problem can find a faster line than the relaxed stage
     // did (it stopped short of its optimum, or in a slower basin): that line is rounded too, and the plan
     // that comes of it is a start again, so that the certificate stays no slower than the plan.
-    if let Some(line) = plan_as_certificate_start(planner, &mut certifier, &best, lo, progress) {
+    let faster_line = match certifier.another_optimum(same_optimum_s, frame_to_beat) {
+        Some(plan) => {
+            let line = plan.controls.clone();
+            let rounding = Rounding {
+                lo,
+                margins,
+                greedy_s,
+            };
+            another_optimum_beside_the_plan_as_start(
+                planner,
+                &mut certifier,
+                line,
+                rounding,
+                progress,
+                &mut best,
+            )
+        }
+        None => plan_as_certificate_start(planner, &mut certifier, &best, lo, progress),
+    };
+    if let Some(line) = faster_line {
         plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, &mut best);
         plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
     }
@@ -147,6 +162,62 @@ pub(super) fn plan_airborne(
         certifier,
         relaxed_found: true,
     }
+}
+
+/// What the exact plans of a certificate's line are held to: no plan crosses before frame `lo`, each
+/// is rounded from lines at `margins`, and one is kept only if faster than `greedy_s` seconds.
+#[derive(Clone, Copy)]
+struct Rounding {
+    lo: usize,
+    margins: LineMargins,
+    greedy_s: f64,
+}
+
+/// The exact plans of `line`, another optimum of the certificate's problem, with the plan so far as the
+/// certificate's start solved beside them on a fork: the two need nothing of each other, and after the
+/// relaxed stage nothing else keeps the second core busy. Where the rounding gives a faster plan, that
+/// plan is a start too (as the plan so far would have been had the two run one after the other). Returns
+/// the line solved from a plan as a start when it is the certificate's fastest.
+fn another_optimum_beside_the_plan_as_start(
+    planner: &mut Planner,
+    certifier: &mut Certifier,
+    line: Vec<FrameControl>,
+    rounding: Rounding,
+    progress: &mut dyn FnMut(Progress),
+    best: &mut BestPlan,
+) -> Option<Vec<FrameControl>> {
+    let Rounding {
+        lo,
+        margins,
+        greedy_s,
+    } = rounding;
+    let plan_so_far_s = best.as_ref().map(|b| b.0);
+    let start = plan_as_start(planner, certifier, best);
+    let solve_start = start.map(|start| {
+        move |fork: &mut Planner| {
+            let mut side = Certifier::default();
+            let won = side.add_start(fork, &mut |_| {}, start, StartKind::Planned, lo);
+            (won, side)
+        }
+    });
+    let ((), side) = planner.beside_forks(solve_start.into_iter().collect(), |planner| {
+        plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, best);
+    });
+    let mut faster_line = None;
+    for (won, side_certifier) in side {
+        if certifier.absorb(side_certifier) && won {
+            faster_line = certifier.best().map(|p| p.controls.clone());
+        }
+    }
+    let improved = best
+        .as_ref()
+        .is_some_and(|b| plan_so_far_s.is_none_or(|t| b.0 < t));
+    if improved {
+        if let Some(l) = plan_as_certificate_start(planner, certifier, best, lo, progress) {
+            faster_line = Some(l);
+        }
+    }
+    faster_line
 }
 
 /// How far apart in time two lines of the certificate's problem may cross and still be one optimum to the
@@ -213,13 +284,22 @@ fn plan_as_certificate_start(
     lo: usize,
     progress: &mut dyn FnMut(Progress),
 ) -> Option<Vec<FrameControl>> {
-    let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
-    let (_, trace) = best.as_ref().filter(|b| behind(b.0))?;
-    let start = planner.warm_start(trace);
+    let start = plan_as_start(planner, certifier, best)?;
     if !certifier.add_start(planner, progress, start, StartKind::Planned, lo) {
         return None;
     }
     certifier.best().map(|p| p.controls.clone())
+}
+
+/// The plan as played, as a start of the certificate, where it is faster than the certificate.
+fn plan_as_start(
+    planner: &Planner,
+    certifier: &Certifier,
+    best: &BestPlan,
+) -> Option<Vec<FrameControl>> {
+    let behind = |t: f64| certifier.best_time().is_none_or(|c| t < c);
+    let (_, trace) = best.as_ref().filter(|b| behind(b.0))?;
+    Some(planner.warm_start(trace))
 }
 
 /// The warm starts of the certificate's greedy starts: the other clean greedy runs (not from a start at

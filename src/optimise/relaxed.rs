@@ -453,8 +453,9 @@ impl Certifier {
     }
 
     /// Takes in the starts of `other`, solved apart (on another thread), as the starts after this one's:
-    /// their indices follow this one's, and a plan of theirs is the best only if strictly faster.
-    pub(super) fn absorb(&mut self, other: Certifier) {
+    /// their indices follow this one's, and a plan of theirs is the best only if strictly faster. Returns
+    /// whether one is.
+    pub(super) fn absorb(&mut self, other: Certifier) -> bool {
         let offset = self.tried;
         self.tried += other.tried;
         self.ends.extend(other.ends.into_iter().map(|e| StartEnd {
@@ -471,8 +472,10 @@ impl Certifier {
                     start_index: plan.start_index + offset,
                     ..plan
                 });
+                return true;
             }
         }
+        false
     }
 
     /// The fastest relaxed plan so far.
