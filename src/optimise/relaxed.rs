@@ -568,11 +568,11 @@ mod tests {
     #[test]
     fn starts_solved_apart_follow_in_order_and_win_only_when_strictly_faster() {
         let mut mine = certifier_of(1, &[0.5], 0);
-        // A tie does not replace the plan already held.
-        mine.absorb(certifier_of(2, &[0.7, 0.5], 1));
+        // A tie does not replace the plan already held, and says so.
+        assert!(!mine.absorb(certifier_of(2, &[0.7, 0.5], 1)));
         assert_eq!(mine.best().map(|b| b.start_index), Some(0));
         // A faster plan does, numbered after every start before it.
-        mine.absorb(certifier_of(1, &[0.25], 0));
+        assert!(mine.absorb(certifier_of(1, &[0.25], 0)));
         assert_eq!(mine.best().map(|b| b.start_index), Some(3));
         let c = mine
             .certificate()
@@ -580,10 +580,10 @@ mod tests {
         assert_eq!((c.starts, c.reached), (4, 4));
         assert!((c.spread - 0.0045).abs() < 1e-12, "{c:?}");
         // A certifier whose starts reached nothing adds its starts only.
-        mine.absorb(Certifier {
+        assert!(!mine.absorb(Certifier {
             tried: 2,
             ..Certifier::default()
-        });
+        }));
         let c = mine
             .certificate()
             .unwrap_or_else(|| panic!("no certificate"));
