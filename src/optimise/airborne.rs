@@ -134,19 +134,19 @@ pub(super) fn plan_airborne(
     // Descending from the plan, the certificate's problem can find a faster line than the relaxed stage
     // did (it stopped short of its optimum, or in a slower basin): that line is rounded too, and the plan
     // that comes of it is a start again, so that the certificate stays no slower than the plan.
+    let terms = PlanTerms {
+        lo,
+        margins,
+        greedy_s,
+    };
     let faster_line = match certifier.another_optimum(same_optimum_s, frame_to_beat) {
         Some(plan) => {
             let line = plan.controls.clone();
-            let rounding = Rounding {
-                lo,
-                margins,
-                greedy_s,
-            };
             another_optimum_beside_the_plan_as_start(
                 planner,
                 &mut certifier,
                 line,
-                rounding,
+                terms,
                 progress,
                 &mut best,
             )
@@ -154,7 +154,7 @@ pub(super) fn plan_airborne(
         None => plan_as_certificate_start(planner, &mut certifier, &best, lo, progress),
     };
     if let Some(line) = faster_line {
-        plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, &mut best);
+        plans_of_certificate_line(planner, line, terms, progress, &mut best);
         plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
     }
     AirbornePlan {
@@ -167,7 +167,7 @@ pub(super) fn plan_airborne(
 /// What the exact plans of a certificate's line are held to: no plan crosses before frame `lo`, each
 /// is rounded from lines at `margins`, and one is kept only if faster than `greedy_s` seconds.
 #[derive(Clone, Copy)]
-struct Rounding {
+struct PlanTerms {
     lo: usize,
     margins: LineMargins,
     greedy_s: f64,
@@ -182,15 +182,11 @@ fn another_optimum_beside_the_plan_as_start(
     planner: &mut Planner,
     certifier: &mut Certifier,
     line: Vec<FrameControl>,
-    rounding: Rounding,
+    terms: PlanTerms,
     progress: &mut dyn FnMut(Progress),
     best: &mut BestPlan,
 ) -> Option<Vec<FrameControl>> {
-    let Rounding {
-        lo,
-        margins,
-        greedy_s,
-    } = rounding;
+    let lo = terms.lo;
     let plan_so_far_s = best.as_ref().map(|b| b.0);
     let start = plan_as_start(planner, certifier, best);
     let solve_start = start.map(|start| {
@@ -201,7 +197,7 @@ fn another_optimum_beside_the_plan_as_start(
         }
     });
     let ((), side) = planner.beside_forks(solve_start.into_iter().collect(), |planner| {
-        plans_of_certificate_line(planner, line, lo, margins, greedy_s, progress, best);
+        plans_of_certificate_line(planner, line, terms, progress, best);
     });
     let mut faster_line = None;
     for (won, side_certifier) in side {
@@ -234,13 +230,12 @@ fn same_optimum_s(planner: &Planner, line: &[FrameControl]) -> f64 {
 }
 
 /// The exact plans of a line of the certificate's problem faster than the relaxed plan's: the line is
-/// refined at the planning margin, then rounded, polished and verified; a faster plan replaces `best`.
+/// refined at the planning margin, then rounded, polished and verified as `terms` say; a faster plan
+/// replaces `best`.
 fn plans_of_certificate_line(
     planner: &mut Planner,
     line: Vec<FrameControl>,
-    lo: usize,
-    margins: LineMargins,
-    greedy_s: f64,
+    terms: PlanTerms,
     progress: &mut dyn FnMut(Progress),
     best: &mut BestPlan,
 ) {
@@ -248,8 +243,9 @@ fn plans_of_certificate_line(
         Some(_) => Widening::FinalMargin,
         None => Widening::FinalMarginAndLine,
     };
-    if let Some(source) = refined(planner, progress, line, lo, margins.planning, widening) {
-        exact_plans(planner, &source, greedy_s, best);
+    let planning = terms.margins.planning;
+    if let Some(source) = refined(planner, progress, line, terms.lo, planning, widening) {
+        exact_plans(planner, &source, terms.greedy_s, best);
     }
 }
 

@@ -158,6 +158,17 @@ pub struct FrameJacobian {
     pub b: [[f64; 2]; 4],
 }
 
+impl FrameJacobian {
+    /// The state change after the frame to first order, `dx' = A dx + B du`, from the state change `dx`
+    /// before it and the control change `du = (d sigma, d c)`.
+    pub fn state_change(&self, dx: &[f64; 4], du: &[f64; 2]) -> [f64; 4] {
+        std::array::from_fn(|i| {
+            (0..4).map(|j| self.a[i][j] * dx[j]).sum::<f64>()
+                + (0..2).map(|j| self.b[i][j] * du[j]).sum::<f64>()
+        })
+    }
+}
+
 /// Arithmetic of forward-mode automatic differentiation over the frame's four inputs `(V, psi, c, sigma)`:
 /// the frame is written once over this trait and evaluated with [`Dual`] (first derivatives) or
 /// [`Dual2`] (first and second).

@@ -311,7 +311,7 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     };
     // The step is judged on what its control changes do: Clarabel meets the dynamics rows only to its
     // feasibility tolerance, and along a chain of thousands of frames their residuals add up.
-    let x = with_the_states_of_its_controls(sp.jacobians, &solution.x, iu, ix);
+    let x = with_the_states_of_its_controls(sp.jacobians, solution.x, iu, ix);
     let du: Vec<(f64, f64)> = (0..n)
         .map(|k| {
             let change = |j: usize| iu(k, j).map_or(0.0, |v| x[v]);
@@ -441,27 +441,23 @@ fn clarabel_solution(
 /// on").
 fn with_the_states_of_its_controls(
     jacobians: &[FrameJacobian],
-    x: &[f64],
+    mut x: Vec<f64>,
     iu: impl Fn(usize, usize) -> Option<usize>,
     ix: impl Fn(usize, usize) -> usize,
 ) -> Vec<f64> {
-    let mut states = x.to_vec();
+    let mut before = [0.0; 4];
     for (k, jac) in jacobians.iter().enumerate() {
-        let before: [f64; 4] = match k {
-            0 => [0.0; 4],
-            _ => std::array::from_fn(|j| states[ix(k - 1, j)]),
-        };
         let du: [f64; 2] = std::array::from_fn(|j| {
             let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
             iu(k, j).map_or(0.0, |v| x[v] * scale)
         });
-        for i in 0..4 {
-            let carried: f64 = (0..4).map(|j| jac.a[i][j] * before[j]).sum();
-            let driven: f64 = (0..2).map(|j| jac.b[i][j] * du[j]).sum();
-            states[ix(k, i)] = carried + driven;
+        let after = jac.state_change(&before, &du);
+        for (i, &d) in after.iter().enumerate() {
+            x[ix(k, i)] = d;
         }
+        before = after;
     }
-    states
+    x
 }
 
 #[cfg(test)]

@@ -741,11 +741,7 @@ mod tests {
         let mut dx = [0.0; 4];
         let mut furthest = 0.0_f64;
         for (k, jac) in lz.lin.jacobians.iter().enumerate() {
-            let du = [step.du[k].0, step.du[k].1];
-            dx = std::array::from_fn(|i| {
-                (0..4).map(|j| jac.a[i][j] * dx[j]).sum::<f64>()
-                    + (0..2).map(|j| jac.b[i][j] * du[j]).sum::<f64>()
-            });
+            dx = jac.state_change(&dx, &[step.du[k].0, step.du[k].1]);
             furthest = furthest.max((Vec2::new(dx[0], dx[1]) - step.dp[k]).length());
         }
         assert!(furthest < 1e-9, "{furthest} units apart");
