@@ -84,17 +84,23 @@ impl FrameLaw {
         self.law.l.min(BRAKE_COS_LIMIT * v).max(self.c_max(v))
     }
 
-    /// The anglemod guard's band around the kink at speed `v` in case 1, ups: from
-    /// [`FrameLaw::c_plan_max`] to as far above the kink, where the game's quantised yaw can put a frame on
-    /// either piece of the law; `None` in case 2 (no guard).
+    /// The anglemod guard's band around the kink at speed `v`, ups: half an anglemod step either side of
+    /// it (`V q / 2`), where the game's quantised yaw can put a frame on either piece of the law. In case 1
+    /// the kink is the maximum-acceleration `c` and the band's bottom is [`FrameLaw::c_plan_max`]. In case
+    /// 2 the kink is the frame of the largest turn (`mu` reaches `gamma1` there, at the least braking), a
+    /// frame a turning plan plays over and over: on the kink, the replay's yaw puts each such frame either
+    /// below it, gaining less speed at the slope `gamma1 / V` (docs/physics.md section 6), or above it,
+    /// turning less, and the plan's speed drifts away a few ten-thousandths of an ups a frame, tenths of a
+    /// unit over a turning run. `None` where no `c` of the plan reaches the kink.
     pub fn guard_band(&self, v: f64) -> Option<(f64, f64)> {
-        let (guard, kink) = (self.c_plan_max(v), self.kink());
-        (guard < kink).then_some((guard, 2.0 * kink - guard))
+        let (kink, half) = (self.kink(), 0.5 * anglemod_step_ups(v));
+        (kink <= v && kink - half > self.c_min(v)).then_some((kink - half, kink + half))
     }
 
     /// `c` at speed `v` kept out of the anglemod guard's band ([`FrameLaw::guard_band`]): a `c` inside it
-    /// goes down to its lower edge, `c_plan_max` (the frame then gains what the guarded plan counts on);
-    /// every other `c`, and every `c` in case 2, is kept.
+    /// goes down to its lower edge (in case 1 `c_plan_max`, the frame then gains what the guarded plan
+    /// counts on; in case 2 the frame turns as on the kink and gains a little less); every other `c` is
+    /// kept.
     pub fn under_the_guard(&self, c: f64, v: f64) -> f64 {
         match self.guard_band(v) {
             Some((guard, top)) if c > guard && c < top => guard,
@@ -888,7 +894,21 @@ mod tests {
         assert_eq!(fl.under_the_guard(guard + 1e-9, 600.0), guard);
         assert_eq!(fl.under_the_guard(guard - 1.0, 600.0), guard - 1.0);
         assert_eq!(fl.under_the_guard(kink + 1.0, 600.0), kink + 1.0);
+        // Case 2 (100 fps): the maximum-acceleration c = 0 is kept; the kink L - gamma1 = -2, the frame
+        // of the largest turn, has its band, and a frame in it goes down to its bottom.
         let (_, fl) = law(100.0);
         assert_eq!(fl.under_the_guard(0.0, 600.0), 0.0);
+        let half = 0.5 * anglemod_step_ups(600.0);
+        let Some((bottom, top)) = fl.guard_band(600.0) else {
+            panic!("no band around the kink in case 2")
+        };
+        assert!((bottom - (-2.0 - half)).abs() < 1e-12 && (top - (-2.0 + half)).abs() < 1e-12);
+        assert_eq!(fl.under_the_guard(-2.0, 600.0), bottom);
+        assert_eq!(
+            fl.under_the_guard(-2.0 - 2.0 * half, 600.0),
+            -2.0 - 2.0 * half
+        );
+        // Below the speed at which braking reaches the kink (0.95 V = 2 ups) there is no band.
+        assert!(fl.guard_band(2.0).is_none());
     }
 }

@@ -145,14 +145,16 @@ fn polished_if_set(
     }
 }
 
-/// `exact` with its sides fixed and `c` polished at `margin`, as two plans: first with every frame at most
+/// `exact` with its sides fixed and `c` polished at `margin`, as up to three plans: first with every frame at most
 /// at the maximum-acceleration turn, as the relaxed plan it was rounded from; then, on from that, with
 /// frames that may turn less ([`super::model::FrameLaw::c_exact_max`]), which moves the sides' phase where
-/// they meet a turn. In the law's first case the second plan's frames left within the anglemod guard's
-/// band go back under it ([`super::model::FrameLaw::under_the_guard`]): each such frame then turns more
-/// than polished, and a few of them put a plan along a wall into it, so the plan is polished once more
-/// with every frame kept to its side of the band. Both plans go on to be quantised and replayed, and the
-/// faster valid one is kept.
+/// they meet a turn. The second plan's frames left within the anglemod guard's band around the law's kink
+/// go down out of it ([`super::model::FrameLaw::under_the_guard`]): in the first case each such frame
+/// then turns more than polished, in the second it gains a little less speed, and either way a few of
+/// them put a plan along a wall into it, so the plan is polished once more with every frame kept to its
+/// side of the band; the plan as polished before that stays a candidate too (where its replay follows
+/// it, it is the faster). The plans go on to be quantised and replayed, and the fastest valid one is
+/// kept; plans that come out the same are given once.
 fn polished(
     planner: &mut Planner,
     exact: Vec<FrameControl>,
@@ -176,26 +178,22 @@ fn polished(
         anglemod_guard: false,
         ..planner.problem(margin, false, 1)
     };
-    let mut turned = planner.stage(pr, exact.clone(), iters).0;
+    let turned = planner.stage(pr, exact.clone(), iters).0;
     let fl = planner.fl;
-    if fl.has_kink_guard() {
-        let guarded = under_the_guard(&planner.start, &turned, &fl);
-        let moved = guarded != turned;
-        turned = guarded;
-        if moved && !planner.timed_out {
-            let pr = ScpProblem {
-                turn_less: true,
-                ..planner.problem(margin, false, 1)
-            };
-            let repaired = planner.stage(pr, turned, iters).0;
-            turned = under_the_guard(&planner.start, &repaired, &fl);
-        }
+    let guarded = under_the_guard(&planner.start, &turned, &fl);
+    let mut plans = Vec::with_capacity(3);
+    if guarded != turned && !planner.timed_out {
+        let pr = ScpProblem {
+            turn_less: true,
+            ..planner.problem(margin, false, 1)
+        };
+        let repaired = planner.stage(pr, guarded, iters).0;
+        plans.push(under_the_guard(&planner.start, &repaired, &fl));
     }
-    if turned == exact {
-        vec![exact]
-    } else {
-        vec![turned, exact]
-    }
+    plans.push(turned);
+    plans.push(exact);
+    plans.dedup();
+    plans
 }
 
 /// `controls` with every frame's `c` out of the anglemod guard's band ([`FrameLaw::under_the_guard`]),
@@ -251,6 +249,7 @@ mod tests {
     use crate::budget::Budget;
     use crate::optimise::planner::{planning_inputs, staircase_scene};
     use crate::optimise::search::SearchSettings;
+    use crate::optimise::verify::PlanPlayer;
     use crate::optimise::Quality;
     use crate::scene::generate::{generate, GeneratorSettings};
 
@@ -380,7 +379,12 @@ mod tests {
         on_the_kink_guard_scene(|planner, warm| {
             let (fl, margin) = (planner.fl, planner.settings.margin_units);
             let plans = polished(planner, warm, margin);
-            assert_eq!(plans.len(), 2, "no frame turned less");
+            // The plan put out of the band and polished again, the one as first polished, the first stage's.
+            assert_eq!(
+                plans.len(),
+                3,
+                "no frame turned less, or none ended in the band"
+            );
             let turned = &plans[0];
             let states = rollout(&planner.start, turned, &fl);
             let violation = planner.problem(margin, false, 1).violation(&states);
@@ -393,6 +397,76 @@ mod tests {
                 Vec::<usize>::new()
             );
         });
+    }
+
+    #[test]
+    fn in_the_second_case_frames_of_the_largest_turn_end_out_of_the_kinks_band() {
+        // The staircase at 100 fps with air acceleration 10: gamma1 = 32 > L = 30, the law's second
+        // case, whose kink (c = -2 ups) is the frame of the largest turn. The relaxed line turns its
+        // corner on such frames; rounded and polished, the plan that may turn less ends with none of them
+        // inside the band the game's yaw cannot resolve, and with some at its bottom edge.
+        let scene = staircase_scene(1);
+        let (sim, bound, base) = planning_inputs(&scene);
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let run = &base.clean[0].trace;
+        let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
+        let (fl, margin) = (planner.fl, settings.margin_units);
+        assert!(!fl.has_kink_guard());
+        let warm = planner.warm_start(run);
+        let relaxed = planner.stage(planner.problem(margin, true, 1), warm, 25).0;
+        let Some(sides) = rounded(&mut planner, &relaxed, ROUNDING_HORIZONS_S[0]) else {
+            panic!("no rounding")
+        };
+        let plans = polished(&mut planner, sides, margin);
+        assert_eq!(
+            plans.len(),
+            3,
+            "no frame turned less, or none ended in the band"
+        );
+        let turned = &plans[0];
+        assert_eq!(
+            in_the_band(&planner.start, turned, &fl, 0.0),
+            Vec::<usize>::new()
+        );
+        let at_the_bottom = turned
+            .iter()
+            .zip(bands(&planner.start, turned, &fl))
+            .filter(|(u, (bottom, _))| (u.c - bottom).abs() < 1e-9)
+            .count();
+        assert!(at_the_bottom > 0, "no frame of the largest turn");
+        let states = rollout(&planner.start, turned, &fl);
+        let violation = planner.problem(margin, false, 1).violation(&states);
+        assert!(
+            violation <= CLEAN_VIOLATION_UNITS,
+            "{violation} units into the walls"
+        );
+        // Replayed on the game's yaws, the plan out of the band keeps to its speed and path; the one as
+        // first polished, whose frames of the largest turn sit on the kink, falls behind (here 0.025 ups
+        // and 0.028 units against 0.006 and 0.009).
+        let (guarded, free) = (
+            replay_drift(&planner, turned),
+            replay_drift(&planner, &plans[1]),
+        );
+        assert!(
+            2.0 * guarded.0 < free.0 && 2.0 * guarded.1 < free.1,
+            "drift out of the band {guarded:?}, on the kink {free:?} (units, ups)"
+        );
+    }
+
+    /// The largest distance (units) and speed difference (ups) between `plan` and its replay on
+    /// quantised yaws ([`PlanPlayer`]).
+    fn replay_drift(planner: &Planner, plan: &[FrameControl]) -> (f64, f64) {
+        let fl = planner.fl;
+        let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan.to_vec(), fl, true);
+        let trace = planner.sim.run_within(&mut player, &planner.budget);
+        let states = rollout(&planner.start, plan, &fl);
+        let replayed = trace.frames.iter().skip(planner.prefix.len()).zip(&states);
+        replayed.fold((0.0, 0.0), |(pos, speed), (f, s)| {
+            (
+                f64::max(pos, (f.pos - s.pos).length()),
+                f64::max(speed, (f.speed - s.speed).abs()),
+            )
+        })
     }
 
     #[test]
