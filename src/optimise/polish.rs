@@ -252,6 +252,7 @@ mod tests {
     use crate::optimise::verify::PlanPlayer;
     use crate::optimise::Quality;
     use crate::scene::generate::{generate, GeneratorSettings};
+    use crate::scene::Scene;
 
     /// How far inside the guard's band a frame may end, as a share of the band's width: the band is
     /// worked out at the speed the stage's linearisation saw, and a step changes the speeds, so a frame
@@ -299,12 +300,18 @@ mod tests {
     /// walls.
     fn on_the_kink_guard_scene(test: impl FnOnce(&mut Planner, Vec<FrameControl>)) {
         let g = generate(11, 28, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
-        let scene = g.scene;
-        let (sim, bound, base) = planning_inputs(&scene);
+        on_a_fast_planner(&g.scene, |planner, warm| {
+            assert!(planner.fl.has_kink_guard());
+            test(planner, warm);
+        });
+    }
+
+    /// Runs `test` with a `fast` planner of `scene` and the warm start of its first clean greedy run.
+    fn on_a_fast_planner(scene: &Scene, test: impl FnOnce(&mut Planner, Vec<FrameControl>)) {
+        let (sim, bound, base) = planning_inputs(scene);
         let settings = SearchSettings::for_quality(Quality::Fast);
         let run = &base.clean[0].trace;
-        let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
-        assert!(planner.fl.has_kink_guard());
+        let mut planner = Planner::new(scene, &sim, &settings, &bound, run, Budget::unlimited());
         let warm = planner.warm_start(run);
         test(&mut planner, warm);
     }
@@ -405,52 +412,48 @@ mod tests {
         // case, whose kink (c = -2 ups) is the frame of the largest turn. The relaxed line turns its
         // corner on such frames; rounded and polished, the plan that may turn less ends with none of them
         // inside the band the game's yaw cannot resolve, and with some at its bottom edge.
-        let scene = staircase_scene(1);
-        let (sim, bound, base) = planning_inputs(&scene);
-        let settings = SearchSettings::for_quality(Quality::Fast);
-        let run = &base.clean[0].trace;
-        let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
-        let (fl, margin) = (planner.fl, settings.margin_units);
-        assert!(!fl.has_kink_guard());
-        let warm = planner.warm_start(run);
-        let relaxed = planner.stage(planner.problem(margin, true, 1), warm, 25).0;
-        let Some(sides) = rounded(&mut planner, &relaxed, ROUNDING_HORIZONS_S[0]) else {
-            panic!("no rounding")
-        };
-        let plans = polished(&mut planner, sides, margin);
-        assert_eq!(
-            plans.len(),
-            3,
-            "no frame turned less, or none ended in the band"
-        );
-        let turned = &plans[0];
-        assert_eq!(
-            in_the_band(&planner.start, turned, &fl, 0.0),
-            Vec::<usize>::new()
-        );
-        let at_the_bottom = turned
-            .iter()
-            .zip(bands(&planner.start, turned, &fl))
-            .filter(|(u, (bottom, _))| (u.c - bottom).abs() < 1e-9)
-            .count();
-        assert!(at_the_bottom > 0, "no frame of the largest turn");
-        let states = rollout(&planner.start, turned, &fl);
-        let violation = planner.problem(margin, false, 1).violation(&states);
-        assert!(
-            violation <= CLEAN_VIOLATION_UNITS,
-            "{violation} units into the walls"
-        );
-        // Replayed on the game's yaws, the plan out of the band keeps to its speed and path; the one as
-        // first polished, whose frames of the largest turn sit on the kink, falls behind (here 0.025 ups
-        // and 0.028 units against 0.006 and 0.009).
-        let (guarded, free) = (
-            replay_drift(&planner, turned),
-            replay_drift(&planner, &plans[1]),
-        );
-        assert!(
-            2.0 * guarded.0 < free.0 && 2.0 * guarded.1 < free.1,
-            "drift out of the band {guarded:?}, on the kink {free:?} (units, ups)"
-        );
+        on_a_fast_planner(&staircase_scene(1), |planner, warm| {
+            let (fl, margin) = (planner.fl, planner.settings.margin_units);
+            assert!(!fl.has_kink_guard());
+            let relaxed = planner.stage(planner.problem(margin, true, 1), warm, 25).0;
+            let Some(sides) = rounded(planner, &relaxed, ROUNDING_HORIZONS_S[0]) else {
+                panic!("no rounding")
+            };
+            let plans = polished(planner, sides, margin);
+            assert_eq!(
+                plans.len(),
+                3,
+                "no frame turned less, or none ended in the band"
+            );
+            let turned = &plans[0];
+            assert_eq!(
+                in_the_band(&planner.start, turned, &fl, 0.0),
+                Vec::<usize>::new()
+            );
+            let at_the_bottom = turned
+                .iter()
+                .zip(bands(&planner.start, turned, &fl))
+                .filter(|(u, (bottom, _))| (u.c - bottom).abs() < 1e-9)
+                .count();
+            assert!(at_the_bottom > 0, "no frame of the largest turn");
+            let states = rollout(&planner.start, turned, &fl);
+            let violation = planner.problem(margin, false, 1).violation(&states);
+            assert!(
+                violation <= CLEAN_VIOLATION_UNITS,
+                "{violation} units into the walls"
+            );
+            // Replayed on the game's yaws, the plan out of the band keeps to its speed and path; the one as
+            // first polished, whose frames of the largest turn sit on the kink, falls behind (here 0.025 ups
+            // and 0.028 units against 0.006 and 0.009).
+            let (guarded, free) = (
+                replay_drift(planner, turned),
+                replay_drift(planner, &plans[1]),
+            );
+            assert!(
+                2.0 * guarded.0 < free.0 && 2.0 * guarded.1 < free.1,
+                "drift out of the band {guarded:?}, on the kink {free:?} (units, ups)"
+            );
+        });
     }
 
     /// The largest distance (units) and speed difference (ups) between `plan` and its replay on
@@ -471,31 +474,27 @@ mod tests {
 
     #[test]
     fn roundings_polished_side_by_side_are_those_polished_one_after_the_other() {
-        let scene = staircase_scene(2);
-        let (sim, bound, base) = planning_inputs(&scene);
-        let settings = SearchSettings::for_quality(Quality::Fast);
-        let run = &base.clean[0].trace;
-        let mut planner = Planner::new(&scene, &sim, &settings, &bound, run, Budget::unlimited());
-        let margin = settings.margin_units;
-        let warm = planner.warm_start(run);
-        let relaxed = planner.stage(planner.problem(margin, true, 1), warm, 25).0;
-        let roundings = distinct_roundings(&mut planner, &relaxed);
-        assert_eq!(roundings.len(), 2, "the horizons round the line alike");
-        let mut one_by_one = planner.fork();
-        let expected: Vec<(bool, Vec<Vec<FrameControl>>)> = roundings
-            .iter()
-            .map(|(primary, sides)| {
-                let plans = polished_if_set(&mut one_by_one, sides.clone(), margin);
-                (*primary, plans)
-            })
-            .collect();
-        let before = planner.stats.subproblems;
-        let side_by_side = polished_side_by_side(&mut planner, roundings, margin);
-        // The same plans in the same order (the first horizon's first), and every thread's work counted.
-        assert!(side_by_side == expected);
-        assert_eq!(
-            planner.stats.subproblems - before,
-            one_by_one.stats.subproblems
-        );
+        on_a_fast_planner(&staircase_scene(2), |planner, warm| {
+            let margin = planner.settings.margin_units;
+            let relaxed = planner.stage(planner.problem(margin, true, 1), warm, 25).0;
+            let roundings = distinct_roundings(planner, &relaxed);
+            assert_eq!(roundings.len(), 2, "the horizons round the line alike");
+            let mut one_by_one = planner.fork();
+            let expected: Vec<(bool, Vec<Vec<FrameControl>>)> = roundings
+                .iter()
+                .map(|(primary, sides)| {
+                    let plans = polished_if_set(&mut one_by_one, sides.clone(), margin);
+                    (*primary, plans)
+                })
+                .collect();
+            let before = planner.stats.subproblems;
+            let side_by_side = polished_side_by_side(planner, roundings, margin);
+            // The same plans in the same order (the first horizon's first), and every thread's work counted.
+            assert!(side_by_side == expected);
+            assert_eq!(
+                planner.stats.subproblems - before,
+                one_by_one.stats.subproblems
+            );
+        });
     }
 }
