@@ -8,6 +8,9 @@
 //!    rather than at the most a braking frame could swing;
 //! 4. each line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
 //!    fastest valid exact plan is kept.
+//!
+//! Where the relaxed stage finds no line from the seed, the certificate's greedy starts' lines are the
+//! ones rounded.
 
 use super::baseline::Baseline;
 use super::model::{rollout, FrameControl};
@@ -88,7 +91,8 @@ pub(super) struct AirbornePlan {
     pub(super) best: BestPlan,
     /// The certificate.
     pub(super) certifier: Certifier,
-    /// Whether the relaxed stage found a line at all.
+    /// Whether a relaxed line was found at all: the relaxed stage's, or where it found none, one of the
+    /// certificate's greedy starts'.
     pub(super) relaxed_found: bool,
 }
 
@@ -110,16 +114,20 @@ pub(super) fn plan_airborne(
     let (mine, side_certifiers) = planner.beside_forks(vec![side], |planner| {
         lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress)
     });
-    // Without a relaxed line there is no plan for a certificate to be beside.
-    let Some((mut certifier, mut best, relaxed_line_frame)) = mine else {
-        return AirbornePlan {
-            best: None,
-            certifier: Certifier::default(),
-            relaxed_found: false,
-        };
-    };
+    // Where the relaxed stage found no line from the seed, a line the certificate's greedy starts reached
+    // is the one to round (the certificate's fastest, as another optimum crossing before any frame).
+    let relaxed_found = mine.is_some();
+    let (mut certifier, mut best, relaxed_line_frame) =
+        mine.unwrap_or((Certifier::default(), None, u64::MAX));
     for side_certifier in side_certifiers {
         certifier.absorb(side_certifier);
+    }
+    if !relaxed_found && certifier.best().is_none() {
+        return AirbornePlan {
+            best,
+            certifier,
+            relaxed_found,
+        };
     }
     // A line of the certificate's problem that is another optimum than the relaxed stage's (a greedy
     // start's, faster by more than the stages can tell apart, or any start's crossing a frame or more
@@ -445,6 +453,7 @@ mod tests {
     use crate::budget::Budget;
     use crate::optimise::planner::{planning_inputs, staircase_scene};
     use crate::optimise::search::SearchSettings;
+    use crate::optimise::verify::time_of;
     use crate::optimise::Quality;
 
     #[test]
@@ -472,6 +481,51 @@ mod tests {
         assert!(
             (own.time - t).abs() < 0.5 * scene.frame_time_s(),
             "{own:?} against {t}"
+        );
+    }
+
+    #[test]
+    fn where_the_seed_gives_no_relaxed_line_a_greedy_starts_line_is_rounded() {
+        // An empty seed: the relaxed stage grows it a few frames at a time and never reaches the line.
+        // The certificate's greedy start (the second clean greedy run) does, and its line is the plan's.
+        let scene = staircase_scene(1);
+        let (sim, bound, base) = planning_inputs(&scene);
+        assert!(base.clean.len() > 1, "no second clean greedy run");
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let mut planner = Planner::new(
+            &scene,
+            &sim,
+            &settings,
+            &bound,
+            base.seed(),
+            Budget::unlimited(),
+        );
+        let lo = (bound.crossing.frames as usize).saturating_sub(1);
+        let greedy_s = time_of(&base.greedy.trace);
+        let found = plan_airborne(
+            &mut planner,
+            &base,
+            Vec::new(),
+            0,
+            lo,
+            greedy_s,
+            &mut |_| {},
+        );
+        assert!(found.relaxed_found);
+        let certificate = found
+            .certifier
+            .certificate()
+            .unwrap_or_else(|| panic!("no certificate"));
+        let Some((t, trace)) = found.best else {
+            panic!("no plan from the greedy start's line")
+        };
+        assert!(
+            trace.feasible() && t < greedy_s,
+            "{t} s against greedy's {greedy_s} s"
+        );
+        assert!(
+            certificate.time <= t,
+            "certificate {certificate:?} behind the plan's {t} s"
         );
     }
 }

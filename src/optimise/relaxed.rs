@@ -249,6 +249,8 @@ pub(super) fn count_search<'a>(
     let problem = |p: &Planner<'a>| relaxed_problem(p, relaxation, frames_per_knot);
     let fl = planner.fl;
     let relaxed_iters = planner.settings.relaxed_iters;
+    // A sub-problem has at least one step to plan (an empty one is no problem for the solver).
+    n = n.max(1);
     let mut best: Option<Vec<FrameControl>> = None;
     let mut grow_tries = 0;
     let mut continue_tries = 0;
