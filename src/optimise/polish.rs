@@ -26,6 +26,17 @@ pub(super) struct RoundedPlan {
     pub(super) primary: bool,
 }
 
+/// A rounding's polished plans ([`polished`]).
+#[derive(Clone, Debug, PartialEq)]
+struct Polished {
+    /// The plans that decide whether wider margins are tried.
+    plans: Vec<Vec<FrameControl>>,
+    /// A further candidate only: the plan that may turn less on the other side of the anglemod guard's
+    /// band from the deciding one. Where it alone stays valid, the wider margins the deciding plans need
+    /// are still tried: their plans there can be the faster.
+    added: Option<Vec<FrameControl>>,
+}
+
 /// Exact-side plans from `relaxed` (solved at `relaxed_margin`, units), polished at `final_margin`, at
 /// every rounding horizon: the plans of the first rounding whose first-horizon plans include one that is
 /// clear and reaches the line, after those of each wider-margin retry that had none (at most
@@ -46,18 +57,24 @@ pub(super) fn rounded_and_polished(
         // candidates, the sides' phase through the turns chosen otherwise.
         let roundings = distinct_roundings(planner, &relaxed);
         let polished = polished_side_by_side(planner, roundings, final_margin);
-        let clear_and_reaching = polished.iter().any(|(primary, plans)| {
+        let clear_and_reaching = polished.iter().any(|(primary, polished)| {
             *primary
-                && plans.iter().any(|plan| {
+                && polished.plans.iter().any(|plan| {
                     let st = rollout(&planner.start, plan, &fl);
                     planner.problem(final_margin, false, 1).violation(&st) <= CLEAN_VIOLATION_UNITS
                         && model_crossing(&planner.start, &st, planner.scene).is_some()
                 })
         });
-        candidates.extend(polished.into_iter().flat_map(|(primary, plans)| {
-            plans
+        candidates.extend(polished.into_iter().flat_map(|(primary, polished)| {
+            let deciding = polished
+                .plans
                 .into_iter()
-                .map(move |controls| RoundedPlan { controls, primary })
+                .map(move |controls| RoundedPlan { controls, primary });
+            let added = polished.added.map(|controls| RoundedPlan {
+                controls,
+                primary: false,
+            });
+            added.into_iter().chain(deciding)
         }));
         planner.note_cut(Stage::Rounding);
         if clear_and_reaching || attempt == margin_retries || planner.timed_out {
@@ -97,7 +114,7 @@ fn polished_side_by_side(
     planner: &mut Planner,
     roundings: Vec<(bool, Vec<FrameControl>)>,
     final_margin: f64,
-) -> Vec<(bool, Vec<Vec<FrameControl>>)> {
+) -> Vec<(bool, Polished)> {
     let mut roundings = roundings.into_iter();
     let Some((first_primary, first_sides)) = roundings.next() else {
         return Vec::new();
@@ -133,15 +150,14 @@ fn rounded(
 
 /// `exact` polished at `final_margin` ([`polished`]), or as it is when the settings polish nothing or the
 /// time is up.
-fn polished_if_set(
-    planner: &mut Planner,
-    exact: Vec<FrameControl>,
-    final_margin: f64,
-) -> Vec<Vec<FrameControl>> {
+fn polished_if_set(planner: &mut Planner, exact: Vec<FrameControl>, final_margin: f64) -> Polished {
     if planner.settings.polish_iters > 0 && !planner.timed_out {
         polished(planner, exact, final_margin)
     } else {
-        vec![exact]
+        Polished {
+            plans: vec![exact],
+            added: None,
+        }
     }
 }
 
@@ -152,14 +168,12 @@ fn polished_if_set(
 /// go down out of it ([`super::model::FrameLaw::under_the_guard`]): in the first case each such frame
 /// then turns more than polished, in the second it gains a little less speed, and either way a few of
 /// them put a plan along a wall into it, so the plan is polished once more with every frame kept to its
-/// side of the band; the plan as polished before that stays a candidate too (where its replay follows
-/// it, it is the faster). The plans go on to be quantised and replayed, and the fastest valid one is
-/// kept; plans that come out the same are given once.
-fn polished(
-    planner: &mut Planner,
-    exact: Vec<FrameControl>,
-    margin: f64,
-) -> Vec<Vec<FrameControl>> {
+/// side of the band. The plan as polished before that move stays a candidate too (where its replay
+/// follows it, it is the faster), given apart as the one that does not decide the margins
+/// ([`Polished::added`]): in the first case the plan as polished, in the second the one out of the band.
+/// The plans go on to be quantised and replayed, and the fastest valid one is kept; plans that come out
+/// the same are given once.
+fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Polished {
     let iters = planner.settings.polish_iters;
     let pr = planner.problem(margin, false, 1);
     let rounded = exact.clone();
@@ -171,7 +185,10 @@ fn polished(
         planner.problem(margin, false, 1).violation(&states) > CLEAN_VIOLATION_UNITS
     };
     if planner.timed_out || stuck {
-        return vec![exact];
+        return Polished {
+            plans: vec![exact],
+            added: None,
+        };
     }
     let pr = ScpProblem {
         turn_less: true,
@@ -180,20 +197,27 @@ fn polished(
     };
     let turned = planner.stage(pr, exact.clone(), iters).0;
     let fl = planner.fl;
-    let guarded = under_the_guard(&planner.start, &turned, &fl);
-    let mut plans = Vec::with_capacity(3);
-    if guarded != turned && !planner.timed_out {
+    let mut guarded = under_the_guard(&planner.start, &turned, &fl);
+    let moved = guarded != turned;
+    if moved && !planner.timed_out {
         let pr = ScpProblem {
             turn_less: true,
             ..planner.problem(margin, false, 1)
         };
         let repaired = planner.stage(pr, guarded, iters).0;
-        plans.push(under_the_guard(&planner.start, &repaired, &fl));
+        guarded = under_the_guard(&planner.start, &repaired, &fl);
     }
-    plans.push(turned);
-    plans.push(exact);
+    // In the first case every plan keeps under the guard and the plan out of the band is the line's own;
+    // in the second the band is only the largest turn's, and the plan as polished is.
+    let (own, added) = match (moved, fl.has_kink_guard()) {
+        (false, _) => (turned, None),
+        (true, true) => (guarded, Some(turned)),
+        (true, false) => (turned, Some(guarded).filter(|_| !planner.timed_out)),
+    };
+    let mut plans = vec![own, exact];
     plans.dedup();
-    plans
+    let added = added.filter(|p| !plans.contains(p));
+    Polished { plans, added }
 }
 
 /// `controls` with every frame's `c` out of the anglemod guard's band ([`FrameLaw::under_the_guard`]),
@@ -385,14 +409,12 @@ mod tests {
         // ends 0.45 units into them).
         on_the_kink_guard_scene(|planner, warm| {
             let (fl, margin) = (planner.fl, planner.settings.margin_units);
-            let plans = polished(planner, warm, margin);
-            // The plan put out of the band and polished again, the one as first polished, the first stage's.
-            assert_eq!(
-                plans.len(),
-                3,
-                "no frame turned less, or none ended in the band"
-            );
-            let turned = &plans[0];
+            let polished = polished(planner, warm, margin);
+            // The plan put out of the band and polished again and the first stage's, and apart from them
+            // the one as first polished.
+            assert_eq!(polished.plans.len(), 2, "no frame turned less");
+            assert!(polished.added.is_some(), "no frame ended in the band");
+            let turned = &polished.plans[0];
             let states = rollout(&planner.start, turned, &fl);
             let violation = planner.problem(margin, false, 1).violation(&states);
             assert!(
@@ -419,13 +441,11 @@ mod tests {
             let Some(sides) = rounded(planner, &relaxed, ROUNDING_HORIZONS_S[0]) else {
                 panic!("no rounding")
             };
-            let plans = polished(planner, sides, margin);
-            assert_eq!(
-                plans.len(),
-                3,
-                "no frame turned less, or none ended in the band"
-            );
-            let turned = &plans[0];
+            let polished = polished(planner, sides, margin);
+            assert_eq!(polished.plans.len(), 2, "no frame turned less");
+            let Some(turned) = &polished.added else {
+                panic!("no frame ended in the band")
+            };
             assert_eq!(
                 in_the_band(&planner.start, turned, &fl, 0.0),
                 Vec::<usize>::new()
@@ -447,7 +467,7 @@ mod tests {
             // and 0.028 units against 0.006 and 0.009).
             let (guarded, free) = (
                 replay_drift(planner, turned),
-                replay_drift(planner, &plans[1]),
+                replay_drift(planner, &polished.plans[0]),
             );
             assert!(
                 2.0 * guarded.0 < free.0 && 2.0 * guarded.1 < free.1,
@@ -480,7 +500,7 @@ mod tests {
             let roundings = distinct_roundings(planner, &relaxed);
             assert_eq!(roundings.len(), 2, "the horizons round the line alike");
             let mut one_by_one = planner.fork();
-            let expected: Vec<(bool, Vec<Vec<FrameControl>>)> = roundings
+            let expected: Vec<(bool, Polished)> = roundings
                 .iter()
                 .map(|(primary, sides)| {
                     let plans = polished_if_set(&mut one_by_one, sides.clone(), margin);
