@@ -451,7 +451,7 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
 mod tests {
     use super::*;
     use crate::budget::Budget;
-    use crate::optimise::planner::{planning_inputs, staircase_scene};
+    use crate::optimise::planner::{planning_inputs, staircase_scene, with_fast_planner};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::verify::time_of;
     use crate::optimise::Quality;
@@ -488,44 +488,27 @@ mod tests {
     fn where_the_seed_gives_no_relaxed_line_a_greedy_starts_line_is_rounded() {
         // An empty seed: the relaxed stage grows it a few frames at a time and never reaches the line.
         // The certificate's greedy start (the second clean greedy run) does, and its line is the plan's.
-        let scene = staircase_scene(1);
-        let (sim, bound, base) = planning_inputs(&scene);
-        assert!(base.clean.len() > 1, "no second clean greedy run");
-        let settings = SearchSettings::for_quality(Quality::Fast);
-        let mut planner = Planner::new(
-            &scene,
-            &sim,
-            &settings,
-            &bound,
-            base.seed(),
-            Budget::unlimited(),
-        );
-        let lo = (bound.crossing.frames as usize).saturating_sub(1);
-        let greedy_s = time_of(&base.greedy.trace);
-        let found = plan_airborne(
-            &mut planner,
-            &base,
-            Vec::new(),
-            0,
-            lo,
-            greedy_s,
-            &mut |_| {},
-        );
-        assert!(found.relaxed_found);
-        let certificate = found
-            .certifier
-            .certificate()
-            .unwrap_or_else(|| panic!("no certificate"));
-        let Some((t, trace)) = found.best else {
-            panic!("no plan from the greedy start's line")
-        };
-        assert!(
-            trace.feasible() && t < greedy_s,
-            "{t} s against greedy's {greedy_s} s"
-        );
-        assert!(
-            certificate.time <= t,
-            "certificate {certificate:?} behind the plan's {t} s"
-        );
+        with_fast_planner(&staircase_scene(1), |planner, base, bound| {
+            assert!(base.clean.len() > 1, "no second clean greedy run");
+            let lo = (bound.crossing.frames as usize).saturating_sub(1);
+            let greedy_s = time_of(&base.greedy.trace);
+            let found = plan_airborne(planner, base, Vec::new(), 0, lo, greedy_s, &mut |_| {});
+            assert!(found.relaxed_found);
+            let certificate = found
+                .certifier
+                .certificate()
+                .unwrap_or_else(|| panic!("no certificate"));
+            let Some((t, trace)) = found.best else {
+                panic!("no plan from the greedy start's line")
+            };
+            assert!(
+                trace.feasible() && t < greedy_s,
+                "{t} s against greedy's {greedy_s} s"
+            );
+            assert!(
+                certificate.time <= t,
+                "certificate {certificate:?} behind the plan's {t} s"
+            );
+        });
     }
 }

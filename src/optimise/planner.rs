@@ -289,6 +289,26 @@ pub(super) fn planning_inputs(
     (sim, bound, base)
 }
 
+/// Runs `test` with a `fast` planner of `scene` seeded as a solve seeds it (its first clean greedy run),
+/// with the baseline and the lower bound it was made from (for the tests of the stages).
+#[cfg(test)]
+pub(super) fn with_fast_planner<R>(
+    scene: &Scene,
+    test: impl FnOnce(&mut Planner, &super::baseline::Baseline, &LowerBound) -> R,
+) -> R {
+    let (sim, bound, base) = planning_inputs(scene);
+    let settings = super::search::SearchSettings::for_quality(super::Quality::Fast);
+    let mut planner = Planner::new(
+        scene,
+        &sim,
+        &settings,
+        &bound,
+        base.seed(),
+        Budget::unlimited(),
+    );
+    test(&mut planner, &base, &bound)
+}
+
 /// The default staircase (`scene::generate::Staircase`) of `corners` corners, for the tests of the stages.
 #[cfg(test)]
 pub(super) fn staircase_scene(corners: u32) -> Scene {

@@ -270,11 +270,8 @@ fn resolved_wider(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::budget::Budget;
-    use crate::optimise::planner::{planning_inputs, staircase_scene};
-    use crate::optimise::search::SearchSettings;
+    use crate::optimise::planner::{staircase_scene, with_fast_planner};
     use crate::optimise::verify::PlanPlayer;
-    use crate::optimise::Quality;
     use crate::scene::generate::{generate, GeneratorSettings};
     use crate::scene::Scene;
 
@@ -330,14 +327,13 @@ mod tests {
         });
     }
 
-    /// Runs `test` with a `fast` planner of `scene` and the warm start of its first clean greedy run.
+    /// Runs `test` with a `fast` planner of `scene` and the warm start of its seed, its first clean greedy
+    /// run ([`with_fast_planner`]).
     fn on_a_fast_planner(scene: &Scene, test: impl FnOnce(&mut Planner, Vec<FrameControl>)) {
-        let (sim, bound, base) = planning_inputs(scene);
-        let settings = SearchSettings::for_quality(Quality::Fast);
-        let run = &base.clean[0].trace;
-        let mut planner = Planner::new(scene, &sim, &settings, &bound, run, Budget::unlimited());
-        let warm = planner.warm_start(run);
-        test(&mut planner, warm);
+        with_fast_planner(scene, |planner, base, _| {
+            let warm = planner.warm_start(base.seed());
+            test(planner, warm);
+        });
     }
 
     #[test]

@@ -533,7 +533,7 @@ mod tests {
     use super::*;
     use crate::budget::Budget;
     use crate::optimise::airborne::LineMargins;
-    use crate::optimise::planner::{planning_inputs, staircase_scene};
+    use crate::optimise::planner::{planning_inputs, staircase_scene, with_fast_planner};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
 
@@ -732,44 +732,35 @@ mod tests {
         // against the walls and the search stops short at 475.
         use crate::scene::generate::{generate, GeneratorSettings};
         let g = generate(97, 23, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
-        let scene = g.scene;
-        let (sim, bound, base) = planning_inputs(&scene);
-        let settings = SearchSettings::for_quality(Quality::Fast);
-        let mut planner = Planner::new(
-            &scene,
-            &sim,
-            &settings,
-            &bound,
-            base.seed(),
-            Budget::unlimited(),
-        );
-        let warm = planner.warm_start(&base.clean[1].trace);
-        let n = warm.len();
-        let planning = Relaxation::planning(LineMargins::of(&planner).planning);
-        let certificate = Relaxation::certificate();
-        let mut ends = Vec::new();
-        for first in [Some(planning), None] {
-            let descent = Descent {
-                after_unclear_knots: first,
-                ..Descent::greedy_start(planning)
-            };
-            let mut line = None;
-            let counts = counts_tried(|record| {
-                let start = warm.clone();
-                line = relaxed_plan(&mut planner, record, start, n, 0, certificate, descent).line;
-            });
-            // Knots first: the count search's first count is theirs.
-            let knot = coarse_knot_frames(n, CoarseRuns::AlsoShort) as usize;
-            assert!(knot > 1, "{knot}");
-            assert!(counts.first().is_some_and(|&c| c % knot == 0), "{counts:?}");
-            let frames = line
-                .as_deref()
-                .and_then(|l| planner.crossing_of(l))
-                .map_or(u64::MAX, |c| c.frames);
-            ends.push(frames);
-        }
-        assert!(ends[0] <= 355, "{ends:?}");
-        assert!(ends[0] + 10 <= ends[1], "{ends:?}");
+        with_fast_planner(&g.scene, |planner, base, _| {
+            let warm = planner.warm_start(&base.clean[1].trace);
+            let n = warm.len();
+            let planning = Relaxation::planning(LineMargins::of(planner).planning);
+            let certificate = Relaxation::certificate();
+            let mut ends = Vec::new();
+            for first in [Some(planning), None] {
+                let descent = Descent {
+                    after_unclear_knots: first,
+                    ..Descent::greedy_start(planning)
+                };
+                let mut line = None;
+                let counts = counts_tried(|record| {
+                    let start = warm.clone();
+                    line = relaxed_plan(planner, record, start, n, 0, certificate, descent).line;
+                });
+                // Knots first: the count search's first count is theirs.
+                let knot = coarse_knot_frames(n, CoarseRuns::AlsoShort) as usize;
+                assert!(knot > 1, "{knot}");
+                assert!(counts.first().is_some_and(|&c| c % knot == 0), "{counts:?}");
+                let frames = line
+                    .as_deref()
+                    .and_then(|l| planner.crossing_of(l))
+                    .map_or(u64::MAX, |c| c.frames);
+                ends.push(frames);
+            }
+            assert!(ends[0] <= 355, "{ends:?}");
+            assert!(ends[0] + 10 <= ends[1], "{ends:?}");
+        });
     }
 
     #[test]
