@@ -37,6 +37,16 @@ struct Polished {
     added: Option<Vec<FrameControl>>,
 }
 
+impl Polished {
+    /// `plan` alone, as it is.
+    fn only(plan: Vec<FrameControl>) -> Self {
+        Polished {
+            plans: vec![plan],
+            added: None,
+        }
+    }
+}
+
 /// Exact-side plans from `relaxed` (solved at `relaxed_margin`, units), polished at `final_margin`, at
 /// every rounding horizon: the plans of the first rounding whose first-horizon plans include one that is
 /// clear and reaches the line, after those of each wider-margin retry that had none (at most
@@ -154,15 +164,12 @@ fn polished_if_set(planner: &mut Planner, exact: Vec<FrameControl>, final_margin
     if planner.settings.polish_iters > 0 && !planner.timed_out {
         polished(planner, exact, final_margin)
     } else {
-        Polished {
-            plans: vec![exact],
-            added: None,
-        }
+        Polished::only(exact)
     }
 }
 
-/// `exact` with its sides fixed and `c` polished at `margin`, as up to three plans: first with every frame at most
-/// at the maximum-acceleration turn, as the relaxed plan it was rounded from; then, on from that, with
+/// `exact` with its sides fixed and `c` polished at `margin`, as up to three plans: first with every frame
+/// at most at the maximum-acceleration turn, as the relaxed plan it was rounded from; then, on from that, with
 /// frames that may turn less ([`super::model::FrameLaw::c_exact_max`]), which moves the sides' phase where
 /// they meet a turn. The second plan's frames left within the anglemod guard's band around the law's kink
 /// go down out of it ([`super::model::FrameLaw::under_the_guard`]): in the first case each such frame
@@ -185,10 +192,7 @@ fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Pol
         planner.problem(margin, false, 1).violation(&states) > CLEAN_VIOLATION_UNITS
     };
     if planner.timed_out || stuck {
-        return Polished {
-            plans: vec![exact],
-            added: None,
-        };
+        return Polished::only(exact);
     }
     let pr = ScpProblem {
         turn_less: true,
