@@ -56,10 +56,10 @@ pub fn anglemod_bracket(yaw_rad: f64) -> (f64, f64) {
     (yaw_on_step_rad(k.floor()), yaw_on_step_rad(k.ceil()))
 }
 
-/// The yaw of anglemod step `k` (a whole number), radians, nudged a millionth of a step up so that the
-/// game's `f32` truncation lands on the step and not the one below.
-fn yaw_on_step_rad(k: f64) -> f64 {
-    ((k + 1e-6) * ANGLEMOD_STEP_DEG).to_radians()
+/// The yaw of anglemod step `k` (a whole number), radians, nudged a millionth of a step away from zero so
+/// that the game's `f32` truncation (towards zero) lands on the step and not the one nearer zero.
+pub fn yaw_on_step_rad(k: f64) -> f64 {
+    ((k + 1e-6_f64.copysign(k)) * ANGLEMOD_STEP_DEG).to_radians()
 }
 
 /// An `f64` state rounded to the game's `f32`.
@@ -180,8 +180,10 @@ mod tests {
 
     #[test]
     fn quantised_yaws_survive_anglemod() {
-        for i in 0..1000 {
-            let yaw = -7.0 + 0.0137 * i as f64;
+        // Every step within a few hundredths of a degree of zero, where the `f32` yaw keeps the nudge
+        // off the step (a nudge up put the steps just below zero one step nearer it), then a spread.
+        let near_zero = (-40..=40).map(|k| f64::from(k) * (360.0f64 / 65536.0).to_radians());
+        for yaw in near_zero.chain((0..1000).map(|i| -7.0 + 0.0137 * f64::from(i))) {
             let q = quantise_yaw_rad(yaw);
             let back = f64::from(anglemod_deg(q.to_degrees() as f32));
             let want = q.to_degrees().rem_euclid(360.0);
