@@ -825,7 +825,7 @@ fn shipped_scenes_pass_and_mutations_apply() {
             accepted += 1;
         }
     }
-    assert_eq!(accepted, 12, "the twelve valid shipped scenes");
+    assert_eq!(accepted, 13, "the thirteen valid shipped scenes");
     let text = b"fps = 100\nx = -1.5e3\nname = \"a1\"\n".to_vec();
     assert_eq!(numbers(&text), vec![(6, 9), (14, 20)]);
     let mut t = text.clone();

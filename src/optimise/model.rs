@@ -15,18 +15,49 @@
 //! `sigma` of a full turn. Raw yaw is a badly conditioned variable (the speed gain changes with slope
 //! about `|v|` per radian near the best angle); `(sigma, c)` are not.
 
-use crate::physics::{AccelLaw, Control, Vec2};
+use crate::physics::curvature::air_law;
+use crate::physics::vectorial::{VECTORIAL_MAX_WISH_SPEED_UPS, VECTORIAL_RESOLUTION_RAD};
+use crate::physics::{AccelLaw, Control, MovementVars, Vec2};
 use std::ops::{Add, Div, Mul, Sub};
 
 /// One anglemod step of the yaw, radians (docs/physics.md section 1: `360 / 65536` degrees).
 const ANGLEMOD_STEP_RAD: f64 =
     std::f64::consts::TAU / crate::physics::engine_exact::ANGLEMOD_STEPS as f64;
 
-/// The change of `c = V cos theta` that one anglemod step of the strafe angle makes near 90 degrees, at
-/// speed `v`, ups: `V q` (`q` = [`ANGLEMOD_STEP_RAD`]). The game's yaw cannot tell apart two plans of a
-/// frame closer than this.
-pub(super) fn anglemod_step_ups(v: f64) -> f64 {
-    v * ANGLEMOD_STEP_RAD
+/// How a replayed plan sets each frame's wish direction in the game, and so how finely.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AngleControl {
+    /// The yaw alone, on anglemod steps, with the side key held: a step `q` of 9.6e-5 rad.
+    Yaw,
+    /// The yaw on an anglemod step with whole forwardmove and sidemove
+    /// ([`crate::physics::vectorial`]): within [`VECTORIAL_RESOLUTION_RAD`] of any angle. Where the
+    /// scene turns it on (`vectorial-compensation = true`), the side key's speed reaches the server's
+    /// maximum speed (the pairs are longer than both, so the wish speed is the same) and that maximum is
+    /// below [`VECTORIAL_MAX_WISH_SPEED_UPS`].
+    Vectorial,
+}
+
+impl AngleControl {
+    /// The angle control of movement variables `vars` ([`AngleControl::Vectorial`] where open).
+    pub fn of(vars: &MovementVars) -> Self {
+        let open =
+            vars.side_key_speed >= vars.maxspeed && vars.maxspeed < VECTORIAL_MAX_WISH_SPEED_UPS;
+        if vars.vectorial_compensation && open {
+            AngleControl::Vectorial
+        } else {
+            AngleControl::Yaw
+        }
+    }
+
+    /// The step in which the game can set the strafe angle, radians: twice the largest error of the
+    /// realised angle, so that half a step is that error (one anglemod step; for vectorial
+    /// compensation twice its resolution).
+    pub fn step_rad(self) -> f64 {
+        match self {
+            AngleControl::Yaw => ANGLEMOD_STEP_RAD,
+            AngleControl::Vectorial => 2.0 * VECTORIAL_RESOLUTION_RAD,
+        }
+    }
 }
 
 /// The strongest braking a plan uses, as `-cos theta` of the strafe angle (see [`FrameLaw::c_min`]).
@@ -41,9 +72,28 @@ pub struct FrameLaw {
     pub law: AccelLaw,
     /// Sidemove held, ups (sets `M`; the yaw is turned by `atan2(S, F)`).
     pub side_key_speed: f64,
+    /// How the replay sets the wish direction, and so the step of `c` the plan keeps clear of the kink by.
+    pub angle_control: AngleControl,
 }
 
 impl FrameLaw {
+    /// The airborne frame law of movement variables `vars` (docs/physics.md section 5).
+    pub fn of(vars: &MovementVars) -> Self {
+        FrameLaw {
+            tau_s: vars.frame_time_s(),
+            law: air_law(vars),
+            side_key_speed: vars.side_key_speed,
+            angle_control: AngleControl::of(vars),
+        }
+    }
+
+    /// The change of `c = V cos theta` that one step of the strafe angle ([`AngleControl::step_rad`])
+    /// makes near 90 degrees, at speed `v`, ups: `V q`. The replay cannot tell apart two plans of a frame
+    /// closer than this.
+    pub fn angle_step_ups(&self, v: f64) -> f64 {
+        v * self.angle_control.step_rad()
+    }
+
     /// The `c` of maximum acceleration at speed `v` (docs/physics.md section 6): `min(L - gamma1, V)` in case 1,
     /// 0 in case 2. Larger `c` gains less speed and turns less, so it is the upper bound of `c`.
     pub fn c_max(&self, v: f64) -> f64 {
@@ -55,10 +105,10 @@ impl FrameLaw {
         }
     }
 
-    /// The largest `c` a plan uses at speed `v`, ups: [`FrameLaw::c_max`], less half an anglemod step of
-    /// the strafe angle (`V q / 2`, `q = 2 pi / 65536`, docs/physics.md section 1) in case 1. There `c_max` is
-    /// the law's kink, and the game's yaw, on anglemod steps, puts the real `c` up to half a step either
-    /// side of the planned one: above the kink `mu = L - c` drops below `gamma1`, below it `c` is smaller,
+    /// The largest `c` a plan uses at speed `v`, ups: [`FrameLaw::c_max`], less half a step of the strafe
+    /// angle (`V q / 2`, `q` = [`AngleControl::step_rad`]: an anglemod step, `2 pi / 65536`, on the yaw
+    /// alone, docs/physics.md sections 1 and 6) in case 1. There `c_max` is the law's kink, and the replay's
+    /// quantised wish direction puts the real `c` up to half a step either side of the planned one: above the kink `mu = L - c` drops below `gamma1`, below it `c` is smaller,
     /// and either way every frame gains less than a plan on the kink. Over thousands of frames (1000 fps)
     /// that loss is about a frame, and a plan along a wall at its margin cannot be replayed. Half a step
     /// under the kink, the replay can follow the plan. In case 2 `c_max = 0` is not at the kink and the
@@ -67,7 +117,7 @@ impl FrameLaw {
         let AccelLaw { l, gamma1 } = self.law;
         let c = self.c_max(v);
         if gamma1 <= l && c >= self.kink() {
-            c - 0.5 * anglemod_step_ups(v)
+            c - 0.5 * self.angle_step_ups(v)
         } else {
             c
         }
@@ -84,8 +134,9 @@ impl FrameLaw {
         self.law.l.min(BRAKE_COS_LIMIT * v).max(self.c_max(v))
     }
 
-    /// The anglemod guard's band around the kink at speed `v`, ups: half an anglemod step either side of
-    /// it (`V q / 2`), where the game's quantised yaw can put a frame on either piece of the law. In case 1
+    /// The anglemod guard's band around the kink at speed `v`, ups: half a step of the strafe angle either
+    /// side of it (`V q / 2`, [`FrameLaw::angle_step_ups`]), where the replay's quantised wish direction can
+    /// put a frame on either piece of the law. In case 1
     /// the kink is the maximum-acceleration `c` and the band's bottom is [`FrameLaw::c_plan_max`]. In case
     /// 2 the kink is the frame of the largest turn (`mu` reaches `gamma1` there, at the least braking), a
     /// frame a turning plan plays over and over: on the kink, the replay's yaw puts each such frame either
@@ -93,7 +144,7 @@ impl FrameLaw {
     /// turning less, and the plan's speed drifts away a few ten-thousandths of an ups a frame, tenths of a
     /// unit over a turning run. `None` where no `c` of the plan reaches the kink.
     pub fn guard_band(&self, v: f64) -> Option<(f64, f64)> {
-        let (kink, half) = (self.kink(), 0.5 * anglemod_step_ups(v));
+        let (kink, half) = (self.kink(), 0.5 * self.angle_step_ups(v));
         (kink <= v && kink - half > self.c_min(v)).then_some((kink - half, kink + half))
     }
 
@@ -109,7 +160,7 @@ impl FrameLaw {
     }
 
     /// Whether the law is in its first case (`gamma1 <= L`), where the maximum-acceleration `c` is the
-    /// kink and [`FrameLaw::c_plan_max`] keeps plans half an anglemod step under it.
+    /// kink and [`FrameLaw::c_plan_max`] keeps plans half a step of the strafe angle under it.
     pub fn has_kink_guard(&self) -> bool {
         self.law.gamma1 <= self.law.l
     }
@@ -615,7 +666,7 @@ pub fn frame_control_of(vel: Vec2, c: &Control) -> FrameControl {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::{curvature::air_law, Effects, MovementVars, PlayerState, Stepper};
+    use crate::physics::{Effects, MovementVars, PlayerState, Stepper};
 
     /// A state for the derivative tests.
     const SAMPLE_STATE: ModelState = ModelState {
@@ -638,14 +689,7 @@ mod tests {
 
     fn law(fps: f64) -> (MovementVars, FrameLaw) {
         let vars = MovementVars::goldsrc(fps);
-        (
-            vars,
-            FrameLaw {
-                tau_s: vars.frame_time_s(),
-                law: air_law(&vars),
-                side_key_speed: vars.side_key_speed,
-            },
-        )
+        (vars, FrameLaw::of(&vars))
     }
 
     #[test]
@@ -898,7 +942,7 @@ mod tests {
         // of the largest turn, has its band, and a frame in it goes down to its bottom.
         let (_, fl) = law(100.0);
         assert_eq!(fl.under_the_guard(0.0, 600.0), 0.0);
-        let half = 0.5 * anglemod_step_ups(600.0);
+        let half = 0.5 * fl.angle_step_ups(600.0);
         let Some((bottom, top)) = fl.guard_band(600.0) else {
             panic!("no band around the kink in case 2")
         };

@@ -6,7 +6,6 @@ use super::scp::{scp_stage, ScpProblem};
 use super::search::{SearchSettings, SearchStats};
 use super::LowerBound;
 use crate::budget::{Budget, Stage};
-use crate::physics::curvature::air_law;
 use crate::physics::{Control, Vec2};
 use crate::scene::Scene;
 use crate::sim::{Crossing, Simulation, Trace};
@@ -38,11 +37,7 @@ pub(super) struct Planner<'a> {
 
 /// The airborne frame law of a scene.
 pub(super) fn frame_law(scene: &Scene) -> FrameLaw {
-    FrameLaw {
-        tau_s: scene.frame_time_s(),
-        law: air_law(&scene.vars),
-        side_key_speed: scene.vars.side_key_speed,
-    }
+    FrameLaw::of(&scene.vars)
 }
 
 impl<'a> Planner<'a> {

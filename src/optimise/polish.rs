@@ -275,7 +275,7 @@ fn resolved_wider(
 mod tests {
     use super::*;
     use crate::optimise::planner::{staircase_scene, with_fast_planner};
-    use crate::optimise::verify::PlanPlayer;
+    use crate::optimise::verify::replay_drift;
     use crate::scene::generate::{generate, GeneratorSettings};
     use crate::scene::Scene;
 
@@ -474,22 +474,6 @@ mod tests {
                 "drift out of the band {guarded:?}, on the kink {free:?} (units, ups)"
             );
         });
-    }
-
-    /// The largest distance (units) and speed difference (ups) between `plan` and its replay on
-    /// quantised yaws ([`PlanPlayer`]).
-    fn replay_drift(planner: &Planner, plan: &[FrameControl]) -> (f64, f64) {
-        let fl = planner.fl;
-        let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan.to_vec(), fl, true);
-        let trace = planner.sim.run_within(&mut player, &planner.budget);
-        let states = rollout(&planner.start, plan, &fl);
-        let replayed = trace.frames.iter().skip(planner.prefix.len()).zip(&states);
-        replayed.fold((0.0, 0.0), |(pos, speed), (f, s)| {
-            (
-                f64::max(pos, (f.pos - s.pos).length()),
-                f64::max(speed, (f.speed - s.speed).abs()),
-            )
-        })
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Rounding: from the relaxed plan's continuous sides to the game's `+-1` (docs/physics.md section 5: a
 //! frame's wish direction is on one side of the velocity or the other).
 
-use super::model::{anglemod_step_ups, frame, rollout, FrameControl, FrameLaw, ModelState};
+use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState};
 use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 
 /// How far ahead a heading error is weighed by the side rounding, seconds.
@@ -142,7 +142,7 @@ fn on_target_frame(x: &ModelState, heading: f64, c: f64, fl: &FrameLaw) -> Optio
             - x.heading
     };
     let c_top = fl.c_exact_max(x.speed);
-    let braking = c < -anglemod_step_ups(x.speed);
+    let braking = c < -fl.angle_step_ups(x.speed);
     if braking || c_top <= c || wanted.abs() >= turn(c) || wanted.abs() <= turn(c_top) {
         return None;
     }
@@ -165,15 +165,11 @@ fn on_target_frame(x: &ModelState, heading: f64, c: f64, fl: &FrameLaw) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::{curvature::air_law, MovementVars, Vec2};
+    use crate::physics::{MovementVars, Vec2};
 
     fn law(fps: f64) -> FrameLaw {
         let vars = MovementVars::goldsrc(fps);
-        FrameLaw {
-            tau_s: vars.frame_time_s(),
-            law: air_law(&vars),
-            side_key_speed: vars.side_key_speed,
-        }
+        FrameLaw::of(&vars)
     }
 
     fn start(speed: f64) -> ModelState {
@@ -239,7 +235,7 @@ mod tests {
             assert!(on_target_frame(&x, -0.5 * full_turn, -100.0, &fl).is_none());
             // A frame a hair past the maximum-acceleration one, as the relaxed stage leaves it (in the
             // second case at 90 degrees, `c = 0`), does not brake.
-            let hair = c - 0.1 * anglemod_step_ups(x.speed);
+            let hair = c - 0.1 * fl.angle_step_ups(x.speed);
             assert!(on_target_frame(&x, -0.5 * full_turn, hair, &fl).is_some());
         }
     }

@@ -8,7 +8,6 @@ use super::qp::{self, SubProblem, SubStep, WallRow};
 use super::{lower_bound, SearchSettings};
 use crate::error::{Error, Result};
 use crate::geometry::Separation;
-use crate::physics::curvature::air_law;
 use crate::physics::Vec2;
 use crate::scene::Scene;
 use crate::sim::controllers::{best_greedy, GREEDY_LOOKAHEADS_UNITS};
@@ -55,11 +54,7 @@ impl SubStepSetup {
         let sim = Simulation::new(scene)?;
         let bound = lower_bound(scene, sim.corridor())?;
         let (greedy, _) = best_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS);
-        let fl = FrameLaw {
-            tau_s: scene.frame_time_s(),
-            law: air_law(&scene.vars),
-            side_key_speed: scene.vars.side_key_speed,
-        };
+        let fl = FrameLaw::of(&scene.vars);
         let mut x = ModelState {
             pos: scene.start.pos,
             speed: scene.start.speed(),

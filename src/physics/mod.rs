@@ -9,6 +9,7 @@
 //! - [`curvature`]: turn radius and the radius-speed relation (section 9).
 //! - [`abh`]: the Source jump boost model of the accelerated-backhop article (section 11).
 //! - [`engine_exact`]: the game's own arithmetic (f32, anglemod) and replay drift (section 1).
+//! - [`vectorial`]: the wish direction set finer than anglemod by whole forwardmove and sidemove (section 1).
 
 pub mod abh;
 pub mod closed_form;
@@ -20,6 +21,7 @@ pub mod step;
 pub mod strafe;
 pub mod vars;
 pub mod vec2;
+pub mod vectorial;
 
 pub use effects::{Effect, Effects};
 pub use real::Real;

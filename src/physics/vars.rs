@@ -119,6 +119,13 @@ pub struct MovementVars {
     pub duck_multiplier: f64,
     /// Time to stand up after releasing duck, seconds (Source `TIME_TO_UNDUCK` 0.2; GoldSrc in the air 0).
     pub unduck_time_s: f64,
+    /// Whether a replayed plan may set the wish direction with whole forwardmove and sidemove besides the
+    /// yaw (vectorial compensation, docs/physics.md section 1). Off by default: the game's own client
+    /// scales `(F, S, U)` down to the player's maximum speed before sending it (`CL_CreateMove`), which
+    /// undoes it, so only a replay tool that writes the user command itself can play such a plan. Off,
+    /// the keys stay at their speeds and the yaw alone, on anglemod steps, turns the wish direction.
+    #[serde(default)]
+    pub vectorial_compensation: bool,
 }
 
 impl MovementVars {
@@ -143,6 +150,7 @@ impl MovementVars {
                 side_key_speed: 400.0,
                 duck_multiplier: 0.333,
                 unduck_time_s: 0.0,
+                vectorial_compensation: false,
             },
             Preset::SourceHl2 => MovementVars {
                 game: Game::Source,
@@ -162,6 +170,7 @@ impl MovementVars {
                 side_key_speed: 450.0,
                 duck_multiplier: 0.333,
                 unduck_time_s: 0.2,
+                vectorial_compensation: false,
             },
         }
     }
@@ -323,6 +332,8 @@ pub struct VarOverrides {
     pub duck_multiplier: Option<f64>,
     /// Unduck time, seconds.
     pub unduck_time_s: Option<f64>,
+    /// Vectorial compensation (whole forwardmove and sidemove set with the yaw; off by default).
+    pub vectorial_compensation: Option<bool>,
 }
 
 impl VarOverrides {
@@ -351,7 +362,8 @@ impl VarOverrides {
             forward_key_speed,
             side_key_speed,
             duck_multiplier,
-            unduck_time_s
+            unduck_time_s,
+            vectorial_compensation
         );
         vars.validate()?;
         Ok(vars)

@@ -51,8 +51,9 @@ pub fn frame_time_text(vars: &MovementVars) -> String {
 /// Builds the script of `trace`'s controls for a scene with variables `vars`; `title` goes into the header
 /// comment (the scene's name).
 ///
-/// Errors: [`Error::InvalidValue`] for a Source (Half-Life 2) scene (Bunnymod XT replays Half-Life only) or
-/// an empty trace, [`Error::Numerical`] for a yaw that is not finite.
+/// Errors: [`Error::InvalidValue`] for a Source (Half-Life 2) scene (Bunnymod XT replays Half-Life only), an
+/// empty trace, or a frame whose forwardmove or sidemove is not a key's (a plan with vectorial
+/// compensation), [`Error::Numerical`] for a yaw that is not finite.
 pub fn hltas_script(trace: &Trace, vars: &MovementVars, title: &str) -> Result<HLTAS> {
     if vars.game != Game::GoldSrc {
         return Err(Error::InvalidValue {
@@ -66,6 +67,23 @@ pub fn hltas_script(trace: &Trace, vars: &MovementVars, title: &str) -> Result<H
             name: "--hltas".to_string(),
             value: "a run of 0 frames".to_string(),
             allowed: "a run of at least one frame".to_string(),
+        });
+    }
+    if let Some(i) = trace.controls.iter().position(|c| !on_the_keys(c, vars)) {
+        let c = &trace.controls[i];
+        return Err(Error::InvalidValue {
+            name: "--hltas".to_string(),
+            value: format!(
+                "frame {} with forwardmove {} and sidemove {} (vectorial compensation)",
+                i + 1,
+                c.forwardmove,
+                c.sidemove
+            ),
+            allowed: format!(
+                "movement keys held at their speeds ({} and {} ups): a frame bulk holds keys, not \
+                 forwardmove and sidemove values; solve the scene with vectorial-compensation off",
+                vars.forward_key_speed, vars.side_key_speed
+            ),
         });
     }
     let frame_time = frame_time_text(vars);
@@ -126,6 +144,13 @@ pub fn write_hltas(trace: &Trace, vars: &MovementVars, title: &str, w: impl Writ
     script
         .to_writer(w)
         .map_err(|e| Error::Io(format!("writing the .hltas script: {e:?}")))
+}
+
+/// Whether `c`'s forwardmove and sidemove are the keys a frame bulk can hold: each zero or its key's speed
+/// either way (compared exactly: the controllers copy the key speeds as they are).
+fn on_the_keys(c: &Control, vars: &MovementVars) -> bool {
+    let key = |m: f64, speed: f64| m == 0.0 || m.abs() == speed;
+    key(c.forwardmove, vars.forward_key_speed) && key(c.sidemove, vars.side_key_speed)
 }
 
 /// One frame's bulk, or `None` when the yaw is not finite.
@@ -270,5 +295,22 @@ mod tests {
             hltas_script(&t, &MovementVars::goldsrc(100.0), "x"),
             Err(Error::Numerical(_))
         ));
+    }
+
+    #[test]
+    fn a_plan_with_vectorial_compensation_is_refused() {
+        // Frame 2 sets forwardmove and sidemove to whole numbers other than the keys': a frame bulk holds
+        // keys only, and the script would replay full keys.
+        let mut t = trace(&[0.1, 0.2, 0.3]);
+        t.controls[1].forwardmove = 1303.0;
+        t.controls[1].sidemove = -805.0;
+        let e = hltas_script(&t, &MovementVars::goldsrc(1000.0), "x")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            e.starts_with("--hltas") && e.contains("frame 2") && !e.contains('\n'),
+            "{e}"
+        );
     }
 }
