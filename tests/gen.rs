@@ -401,6 +401,34 @@ fn kinds_keep_each_scene_s_corridor_and_the_airborne_scenes() {
 }
 
 #[test]
+fn vectorial_compensation_keeps_each_scene_and_asks_for_it() {
+    // The family with vectorial compensation: the same drawn scenes, each asking for it in `[engine]`
+    // and nothing else changed.
+    let plain = sample(&GeneratorSettings::ci_sized(), 20);
+    let vectorial = sample(
+        &GeneratorSettings {
+            vectorial_compensation: true,
+            ..GeneratorSettings::ci_sized()
+        },
+        20,
+    );
+    for (p, v) in plain.iter().zip(&vectorial) {
+        assert_eq!(v.drawn, p.drawn, "{}", v.name);
+        assert!(
+            v.toml.contains("\nvectorial-compensation = true\n"),
+            "{}",
+            v.name
+        );
+        assert!(v.scene.vars.vectorial_compensation && !p.scene.vars.vectorial_compensation);
+        let mut as_plain = v.scene.clone();
+        as_plain.vars.vectorial_compensation = false;
+        assert_eq!(as_plain.vars, p.scene.vars, "{}", v.name);
+        assert_eq!(as_plain.walls, p.scene.walls, "{}", v.name);
+        assert_eq!(as_plain.finish, p.scene.finish, "{}", v.name);
+    }
+}
+
+#[test]
 fn impossible_settings_are_an_error_not_a_hang() {
     // Twelve 180-degree turns with 64-unit legs: only strictly alternating sides (2 draws in 4096) make a
     // corridor that does not fold onto itself; three draws find none.

@@ -103,6 +103,10 @@ pub struct FamilyFlags {
     /// the first leg. Scene k keeps its corridor whatever the kinds.
     #[arg(long, value_enum, value_delimiter = ',')]
     pub kinds: Vec<KindArg>,
+    /// Every scene asks for vectorial compensation (`vectorial-compensation = true` in `[engine]`): plans
+    /// for a replay tool that writes forwardmove and sidemove itself. The corridors are the same.
+    #[arg(long)]
+    pub vectorial_compensation: bool,
 }
 
 impl FamilyFlags {
@@ -120,6 +124,7 @@ impl FamilyFlags {
             (self.max_leg.is_some(), "--max-leg"),
             (self.walls.is_some(), "--walls"),
             (!self.kinds.is_empty(), "--kinds"),
+            (self.vectorial_compensation, "--vectorial-compensation"),
         ]
         .into_iter()
         .find_map(|(given, flag)| given.then_some(flag))
@@ -164,6 +169,7 @@ impl FamilyFlags {
             }
             s.kinds = kinds;
         }
+        s.vectorial_compensation = self.vectorial_compensation;
         s.validate().map_err(flag_error)?;
         Ok(s)
     }

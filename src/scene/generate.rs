@@ -218,6 +218,9 @@ pub struct GeneratorSettings {
     /// Most corridors drawn for one scene before giving up (at least 1): the settings then leave (almost)
     /// no corridor that does not overlap itself.
     pub max_corridor_draws: u32,
+    /// Whether every scene asks for vectorial compensation (`vectorial-compensation = true`,
+    /// docs/physics.md section 1); nothing is drawn for it, so scene k keeps its corridor either way.
+    pub vectorial_compensation: bool,
 }
 
 impl Default for GeneratorSettings {
@@ -241,6 +244,7 @@ impl Default for GeneratorSettings {
             max_ground_start_speed_ups: MAX_GROUND_START_SPEED_UPS,
             wall_gap_units: 16,
             max_corridor_draws: MAX_CORRIDOR_DRAWS,
+            vectorial_compensation: false,
         }
     }
 }
@@ -384,6 +388,9 @@ impl GeneratorSettings {
             kinds.join("/"),
             self.wall_gap_units,
         );
+        if self.vectorial_compensation {
+            line.push_str(", vectorial compensation");
+        }
         if self.kinds != [SceneKind::Air] {
             let names: Vec<&str> = self.kinds.iter().map(|k| k.name()).collect();
             let _ = write!(line, ", kinds {}", names.join("/"));
@@ -501,7 +508,8 @@ pub fn generate(seed: u64, index: u64, settings: &GeneratorSettings) -> Result<G
         let name = format!("gen-{seed}-{index}");
         let header = header_comment(seed, index, settings, &drawn);
         let origin = format!("Generated (seed {seed}, scene {index})");
-        let toml = scene_text(&name, &header, &origin, &drawn, &layout);
+        let vectorial = settings.vectorial_compensation;
+        let toml = scene_text(&name, &header, &origin, &drawn, &layout, vectorial);
         let scene = Scene::from_toml_str(&toml, &format!("{name}.toml"))?;
         return Ok(GeneratedScene {
             seed,
@@ -651,13 +659,14 @@ fn header_comment(seed: u64, index: u64, settings: &GeneratorSettings, d: &Drawn
 }
 
 /// The scene file: the leading comment `header`, then the scene with explicit walls; its description
-/// starts with `origin`.
+/// starts with `origin`; with `vectorial_compensation`, its `[engine]` asks for it.
 fn scene_text(
     name: &str,
     header: &str,
     origin: &str,
     d: &Drawn,
     layout: &centreline::Layout,
+    vectorial_compensation: bool,
 ) -> String {
     let corners = d.turns.len();
     let mut s = header.to_string();
@@ -687,6 +696,9 @@ fn scene_text(
         d.fps
     );
     let _ = writeln!(s, "airaccelerate = {}", d.airaccelerate);
+    if vectorial_compensation {
+        let _ = writeln!(s, "vectorial-compensation = true");
+    }
     let _ = writeln!(s, "effects = {}", d.kind.effects());
     let start = Vec2::new(START_OFFSET_UNITS, 0.0);
     let velocity = Vec2::new(f64::from(d.start_speed_ups), 0.0);

@@ -120,7 +120,7 @@ pub fn staircase(spec: &Staircase) -> Result<GeneratedScene> {
         spec.start_speed_ups,
         spec.walls.name()
     );
-    let toml = scene_text(&name, &header, "Staircase", &drawn, &layout);
+    let toml = scene_text(&name, &header, "Staircase", &drawn, &layout, false);
     let scene = Scene::from_toml_str(&toml, &format!("{name}.toml"))?;
     Ok(GeneratedScene {
         seed: 0,
