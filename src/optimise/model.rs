@@ -108,8 +108,9 @@ impl FrameLaw {
     /// The largest `c` a plan uses at speed `v`, ups: [`FrameLaw::c_max`], less half a step of the strafe
     /// angle (`V q / 2`, `q` = [`AngleControl::step_rad`]: an anglemod step, `2 pi / 65536`, on the yaw
     /// alone, docs/physics.md sections 1 and 6) in case 1. There `c_max` is the law's kink, and the replay's
-    /// quantised wish direction puts the real `c` up to half a step either side of the planned one: above the kink `mu = L - c` drops below `gamma1`, below it `c` is smaller,
-    /// and either way every frame gains less than a plan on the kink. Over thousands of frames (1000 fps)
+    /// quantised wish direction puts the real `c` up to half a step either side of the planned one: above
+    /// the kink `mu = L - c` drops below `gamma1`, below it `c` is smaller, and either way every frame
+    /// gains less than a plan on the kink. Over thousands of frames (1000 fps)
     /// that loss is about a frame, and a plan along a wall at its margin cannot be replayed. Half a step
     /// under the kink, the replay can follow the plan. In case 2 `c_max = 0` is not at the kink and the
     /// quantisation error is symmetric: no guard.
