@@ -24,6 +24,13 @@ use std::ops::{Add, Div, Mul, Sub};
 const ANGLEMOD_STEP_RAD: f64 =
     std::f64::consts::TAU / crate::physics::engine_exact::ANGLEMOD_STEPS as f64;
 
+/// The change of `c = V cos theta` that one anglemod step of the strafe angle makes near 90 degrees, at
+/// speed `v`, ups: `V q` (`q` = [`ANGLEMOD_STEP_RAD`]), the scale of a hair either side of a frame at 90
+/// degrees, whichever way the replay sets its angle ([`FrameLaw::angle_step_ups`] is the replay's step).
+pub(super) fn anglemod_step_ups(v: f64) -> f64 {
+    v * ANGLEMOD_STEP_RAD
+}
+
 /// How a replayed plan sets each frame's wish direction in the game, and so how finely.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AngleControl {

@@ -1,7 +1,7 @@
 //! Rounding: from the relaxed plan's continuous sides to the game's `+-1` (docs/physics.md section 5: a
 //! frame's wish direction is on one side of the velocity or the other).
 
-use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState};
+use super::model::{anglemod_step_ups, frame, rollout, FrameControl, FrameLaw, ModelState};
 use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 
 /// How far ahead a heading error is weighed by the side rounding, seconds.
@@ -132,7 +132,8 @@ fn saturated_runs_s(controls: &[FrameControl], tau_s: f64) -> Vec<f64> {
 /// rounding cannot see. A frame brakes when its strafe angle is more than an anglemod step past 90
 /// degrees (`c < -V q`): in the law's second case the maximum-acceleration frame is at 90 degrees
 /// (`c_max = 0`), where the relaxed stage leaves it only to its tolerance, a hair either side, which the
-/// game's yaw cannot tell apart.
+/// game's yaw cannot tell apart (the threshold stays an anglemod step with vectorial compensation too: it
+/// is the relaxed stage's hair, not the replay's step).
 fn on_target_frame(x: &ModelState, heading: f64, c: f64, fl: &FrameLaw) -> Option<FrameControl> {
     let wanted = heading - x.heading;
     let turn = |c: f64| {
@@ -142,7 +143,7 @@ fn on_target_frame(x: &ModelState, heading: f64, c: f64, fl: &FrameLaw) -> Optio
             - x.heading
     };
     let c_top = fl.c_exact_max(x.speed);
-    let braking = c < -fl.angle_step_ups(x.speed);
+    let braking = c < -anglemod_step_ups(x.speed);
     if braking || c_top <= c || wanted.abs() >= turn(c) || wanted.abs() <= turn(c_top) {
         return None;
     }
@@ -165,6 +166,7 @@ fn on_target_frame(x: &ModelState, heading: f64, c: f64, fl: &FrameLaw) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optimise::model::AngleControl;
     use crate::physics::{MovementVars, Vec2};
 
     fn law(fps: f64) -> FrameLaw {
@@ -234,9 +236,19 @@ mod tests {
             assert!(on_target_frame(&x, -1.5 * full_turn, c, &fl).is_none());
             assert!(on_target_frame(&x, -0.5 * full_turn, -100.0, &fl).is_none());
             // A frame a hair past the maximum-acceleration one, as the relaxed stage leaves it (in the
-            // second case at 90 degrees, `c = 0`), does not brake.
-            let hair = c - 0.1 * fl.angle_step_ups(x.speed);
-            assert!(on_target_frame(&x, -0.5 * full_turn, hair, &fl).is_some());
+            // second case at 90 degrees, `c = 0`), does not brake, however finely the replay sets the
+            // angle (with vectorial compensation its step is 32 times finer than the hair).
+            let hair = c - 0.1 * anglemod_step_ups(x.speed);
+            for angle_control in [AngleControl::Yaw, AngleControl::Vectorial] {
+                let fl = FrameLaw {
+                    angle_control,
+                    ..fl
+                };
+                assert!(
+                    on_target_frame(&x, -0.5 * full_turn, hair, &fl).is_some(),
+                    "{fps} fps, {angle_control:?}"
+                );
+            }
         }
     }
 
