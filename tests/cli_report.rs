@@ -1,4 +1,5 @@
-//! `simulate --report`, `simulate --hltas` and `report RESULT.json -o` through the real binary.
+//! `simulate --report`, `simulate --hltas`, `solve --hltas` of a plan with vectorial compensation and
+//! `report RESULT.json -o` through the real binary.
 
 use hltas::types::AutoMovement;
 use hltas::HLTAS;
@@ -219,6 +220,28 @@ fn hltas_is_refused_for_a_source_scene() {
             &s(&script),
         ],
         "--hltas",
+    );
+    assert!(!script.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn hltas_is_refused_for_a_plan_with_vectorial_compensation() {
+    // The 1000 fps bend asks for vectorial compensation: its plan sets forwardmove and sidemove frame by
+    // frame, which a script's frame bulks (keys held at their speeds) cannot carry.
+    let dir = temp_dir("hltas-vectorial");
+    let script = dir.join("bend.hltas");
+    bad(
+        Path::new(env!("CARGO_MANIFEST_DIR")),
+        &[
+            "solve",
+            "scenarios/hl-bend90-1000fps.toml",
+            "--quality",
+            "fast",
+            "--hltas",
+            &s(&script),
+        ],
+        "vectorial compensation",
     );
     assert!(!script.exists());
     let _ = std::fs::remove_dir_all(&dir);
