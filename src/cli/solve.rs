@@ -5,7 +5,7 @@ use super::{progress, write_artifacts_within};
 use crate::budget::{Budget, Stage};
 use crate::error::{Error, Result};
 use crate::optimise::search::{self, time_limit};
-use crate::optimise::{Outcome, Quality, SearchSettings, SearchStatus};
+use crate::optimise::{Outcome, Quality, SearchSettings, SearchStatus, CERTIFIED_CLEARANCE_UNITS};
 use crate::scene::Scene;
 use serde_json::{json, Value};
 
@@ -171,6 +171,21 @@ pub fn rounding_loss_frames(scene: &Scene, o: &Outcome) -> Option<f64> {
     Some((c.time - r.time) / scene.frame_time_s())
 }
 
+/// The rounding loss as the text output prints it, frames; where the plan is ahead of the relaxed
+/// optimum, why: it touches a wall (its least clearance `min_clearance_units` is under
+/// [`CERTIFIED_CLEARANCE_UNITS`], so it is no run of the relaxed problem), or the relaxed optimum found is
+/// a local one.
+fn rounding_loss_text(loss_frames: f64, min_clearance_units: f64) -> String {
+    let why = if loss_frames >= 0.0 {
+        ""
+    } else if min_clearance_units < CERTIFIED_CLEARANCE_UNITS {
+        " (the plan is ahead: it touches a wall, and the relaxed problem holds only runs clear of the walls)"
+    } else {
+        " (the plan is ahead: the relaxed optimum found is a local one)"
+    };
+    format!("{loss_frames:>10.3} frames{why}")
+}
+
 /// A plan in the `--json` object.
 #[derive(serde::Serialize)]
 struct PlanJson<'a> {
@@ -287,7 +302,8 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         ));
     }
     if let Some(loss) = rounding_loss_frames(scene, o) {
-        s.push_str(&field("rounding loss", format!("{loss:>10.3} frames")));
+        let text = rounding_loss_text(loss, o.trace.min_clearance());
+        s.push_str(&field("rounding loss", text));
     }
     if let Some(c) = o.trace.crossing {
         s.push_str(&field(
@@ -326,4 +342,23 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         ),
     ));
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_plan_ahead_of_the_relaxed_optimum_says_why() {
+        // Behind it: the loss alone. Ahead of it, touching a wall (a greedy run sliding along one): not a
+        // run of the relaxed problem. Ahead of it, clear of the walls: the relaxed optimum is local.
+        assert_eq!(rounding_loss_text(0.25, 1.0), "     0.250 frames");
+        let touching = rounding_loss_text(-63.4, 0.0);
+        assert!(touching.starts_with("   -63.400 frames (") && touching.contains("touches a wall"));
+        let clear = rounding_loss_text(-0.2, 2.0 * CERTIFIED_CLEARANCE_UNITS);
+        assert!(
+            clear.contains("a local one") && !clear.contains("wall"),
+            "{clear}"
+        );
+    }
 }

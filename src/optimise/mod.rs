@@ -24,7 +24,7 @@ mod verify;
 pub use baseline::GreedyGuide;
 pub use bound::{lower_bound, LowerBound};
 pub use policy_run::PolicyRun;
-pub use relaxed::RelaxedCertificate;
+pub use relaxed::{RelaxedCertificate, CERTIFIED_CLEARANCE_UNITS};
 pub use search::{
     solve, solve_cancellable, solve_with_progress, Outcome, Progress, Quality, SearchSettings,
     SearchStatus,

@@ -141,6 +141,11 @@ impl Relaxation {
 /// error of each step along a wall lands a hair inside it and the stage never counts a plan as clear.
 const CERTIFICATE_MARGIN_UNITS: f64 = 0.002;
 
+/// The least clearance of the runs the certificate holds, units: half its margin
+/// ([`CERTIFICATE_MARGIN_UNITS`]). A run closer to a wall (one that touches or slides along it) is not a
+/// point of the certificate's problem and can be ahead of it.
+pub const CERTIFIED_CLEARANCE_UNITS: f64 = 0.5 * CERTIFICATE_MARGIN_UNITS;
+
 /// Frames per knot of the coarse stage for a run of about `frames` frames: knots of several frames
 /// once the run is long enough that about [`COARSE_KNOTS`] knots cover it; with
 /// [`CoarseRuns::AlsoShort`], on shorter runs once about [`SHORT_RUN_COARSE_KNOTS`] do; else 1 (no coarse
