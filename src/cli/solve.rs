@@ -171,17 +171,25 @@ pub fn rounding_loss_frames(scene: &Scene, o: &Outcome) -> Option<f64> {
     Some((c.time - r.time) / scene.frame_time_s())
 }
 
-/// The rounding loss as the text output prints it, frames; where the plan is ahead of the relaxed
-/// optimum, why: it touches a wall (its least clearance `min_clearance_units` is under
+/// The rounding loss as the text output prints it, frames: behind the relaxed optimum, about how much of
+/// it is the zigzag of alternating sides (`zigzag_frames`, [`crate::optimise::RelaxedCertificate`]);
+/// ahead of it, why: the plan touches a wall (its least clearance `min_clearance_units` is under
 /// [`CERTIFIED_CLEARANCE_UNITS`], so it is no run of the relaxed problem), or the relaxed optimum found is
 /// a local one.
-fn rounding_loss_text(loss_frames: f64, min_clearance_units: f64) -> String {
+fn rounding_loss_text(
+    loss_frames: f64,
+    min_clearance_units: f64,
+    zigzag_frames: Option<f64>,
+) -> String {
     let why = if loss_frames >= 0.0 {
-        ""
+        zigzag_frames.map_or(String::new(), |z| {
+            format!(" (about {z:.3} of it the estimated zigzag of sides alternating at full acceleration)")
+        })
     } else if min_clearance_units < CERTIFIED_CLEARANCE_UNITS {
         " (the plan is ahead: it touches a wall, and the relaxed problem holds only runs clear of the walls)"
+            .to_string()
     } else {
-        " (the plan is ahead: the relaxed optimum found is a local one)"
+        " (the plan is ahead: the relaxed optimum found is a local one)".to_string()
     };
     format!("{loss_frames:>10.3} frames{why}")
 }
@@ -302,7 +310,8 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         ));
     }
     if let Some(loss) = rounding_loss_frames(scene, o) {
-        let text = rounding_loss_text(loss, o.trace.min_clearance());
+        let zigzag = o.relaxed.and_then(|r| r.zigzag_frames);
+        let text = rounding_loss_text(loss, o.trace.min_clearance(), zigzag);
         s.push_str(&field("rounding loss", text));
     }
     if let Some(c) = o.trace.crossing {
@@ -352,10 +361,15 @@ mod tests {
     fn a_plan_ahead_of_the_relaxed_optimum_says_why() {
         // Behind it: the loss alone. Ahead of it, touching a wall (a greedy run sliding along one): not a
         // run of the relaxed problem. Ahead of it, clear of the walls: the relaxed optimum is local.
-        assert_eq!(rounding_loss_text(0.25, 1.0), "     0.250 frames");
-        let touching = rounding_loss_text(-63.4, 0.0);
+        assert_eq!(rounding_loss_text(0.25, 1.0, None), "     0.250 frames");
+        let zigzag = rounding_loss_text(0.169, 1.0, Some(0.15));
+        assert!(
+            zigzag.starts_with("     0.169 frames (about 0.150 of it the estimated zigzag"),
+            "{zigzag}"
+        );
+        let touching = rounding_loss_text(-63.4, 0.0, Some(0.1));
         assert!(touching.starts_with("   -63.400 frames (") && touching.contains("touches a wall"));
-        let clear = rounding_loss_text(-0.2, 2.0 * CERTIFIED_CLEARANCE_UNITS);
+        let clear = rounding_loss_text(-0.2, 2.0 * CERTIFIED_CLEARANCE_UNITS, None);
         assert!(
             clear.contains("a local one") && !clear.contains("wall"),
             "{clear}"

@@ -495,7 +495,9 @@ fn solve_once(
         }
     };
     Ok(Outcome {
-        relaxed: found.certifier.certificate(),
+        relaxed: found
+            .certifier
+            .certificate_with_zigzag(&planner.start, &planner.fl),
         ..outcome
     })
 }
