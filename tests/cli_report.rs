@@ -207,42 +207,42 @@ fn hltas_replays_the_trajectory_yaws() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Runs `command` with `--hltas` into a fresh directory (`tag`) and checks it is refused in one line
+/// containing `needle`, with no script written.
+fn hltas_refused(tag: &str, command: &[&str], needle: &str) {
+    let dir = temp_dir(tag);
+    let script = s(&dir.join("plan.hltas"));
+    let args: Vec<&str> = command
+        .iter()
+        .copied()
+        .chain(["--hltas", &script])
+        .collect();
+    bad(Path::new(env!("CARGO_MANIFEST_DIR")), &args, needle);
+    assert!(!Path::new(&script).exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn hltas_is_refused_for_a_source_scene() {
-    let dir = temp_dir("hltas-source");
-    let script = dir.join("abh.hltas");
-    bad(
-        Path::new(env!("CARGO_MANIFEST_DIR")),
-        &[
-            "simulate",
-            "scenarios/hl2-abh-100m.toml",
-            "--hltas",
-            &s(&script),
-        ],
+    hltas_refused(
+        "hltas-source",
+        &["simulate", "scenarios/hl2-abh-100m.toml"],
         "--hltas",
     );
-    assert!(!script.exists());
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn hltas_is_refused_for_a_plan_with_vectorial_compensation() {
     // The 1000 fps bend asks for vectorial compensation: its plan sets forwardmove and sidemove frame by
     // frame, which a script's frame bulks (keys held at their speeds) cannot carry.
-    let dir = temp_dir("hltas-vectorial");
-    let script = dir.join("bend.hltas");
-    bad(
-        Path::new(env!("CARGO_MANIFEST_DIR")),
+    hltas_refused(
+        "hltas-vectorial",
         &[
             "solve",
             "scenarios/hl-bend90-1000fps.toml",
             "--quality",
             "fast",
-            "--hltas",
-            &s(&script),
         ],
         "vectorial compensation",
     );
-    assert!(!script.exists());
-    let _ = std::fs::remove_dir_all(&dir);
 }
