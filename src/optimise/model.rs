@@ -16,13 +16,10 @@
 //! about `|v|` per radian near the best angle); `(sigma, c)` are not.
 
 use crate::physics::curvature::air_law;
+use crate::physics::engine_exact::ANGLEMOD_STEP_RAD;
 use crate::physics::vectorial::{VECTORIAL_MAX_WISH_SPEED_UPS, VECTORIAL_RESOLUTION_RAD};
 use crate::physics::{AccelLaw, Control, MovementVars, Vec2};
 use std::ops::{Add, Div, Mul, Sub};
-
-/// One anglemod step of the yaw, radians (docs/physics.md section 1: `360 / 65536` degrees).
-const ANGLEMOD_STEP_RAD: f64 =
-    std::f64::consts::TAU / crate::physics::engine_exact::ANGLEMOD_STEPS as f64;
 
 /// The change of `c = V cos theta` that one anglemod step of the strafe angle makes near 90 degrees, at
 /// speed `v`, ups: `V q` (`q` = [`ANGLEMOD_STEP_RAD`]), the scale of a hair either side of a frame at 90
@@ -117,10 +114,10 @@ impl FrameLaw {
     /// alone, docs/physics.md sections 1 and 6) in case 1. There `c_max` is the law's kink, and the replay's
     /// quantised wish direction puts the real `c` up to half a step either side of the planned one: above
     /// the kink `mu = L - c` drops below `gamma1`, below it `c` is smaller, and either way every frame
-    /// gains less than a plan on the kink. Over thousands of frames (1000 fps)
-    /// that loss is about a frame, and a plan along a wall at its margin cannot be replayed. Half a step
-    /// under the kink, the replay can follow the plan. In case 2 `c_max = 0` is not at the kink and the
-    /// quantisation error is symmetric: no guard.
+    /// gains less than a plan on the kink. Over thousands of frames (1000 fps) that loss is about a frame,
+    /// and a plan along a wall at its margin cannot be replayed. Half a step under the kink, the replay
+    /// can follow the plan. In case 2 `c_max = 0` is not at the kink and the quantisation error is
+    /// symmetric: no guard.
     pub fn c_plan_max(&self, v: f64) -> f64 {
         let AccelLaw { l, gamma1 } = self.law;
         let c = self.c_max(v);
@@ -144,9 +141,8 @@ impl FrameLaw {
 
     /// The anglemod guard's band around the kink at speed `v`, ups: half a step of the strafe angle either
     /// side of it (`V q / 2`, [`FrameLaw::angle_step_ups`]), where the replay's quantised wish direction can
-    /// put a frame on either piece of the law. In case 1
-    /// the kink is the maximum-acceleration `c` and the band's bottom is [`FrameLaw::c_plan_max`]. In case
-    /// 2 the kink is the frame of the largest turn (`mu` reaches `gamma1` there, at the least braking), a
+    /// put a frame on either piece of the law. In case 1 the kink is the maximum-acceleration `c` and the
+    /// band's bottom is [`FrameLaw::c_plan_max`]. In case 2 the kink is the frame of the largest turn (`mu` reaches `gamma1` there, at the least braking), a
     /// frame a turning plan plays over and over: on the kink, the replay's yaw puts each such frame either
     /// below it, gaining less speed at the slope `gamma1 / V` (docs/physics.md section 6), or above it,
     /// turning less, and the plan's speed drifts away a few ten-thousandths of an ups a frame, tenths of a

@@ -577,7 +577,12 @@ impl Certifier {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::{curvature::air_law, MovementVars, Vec2};
+    use crate::budget::Budget;
+    use crate::optimise::airborne::LineMargins;
+    use crate::optimise::planner::{planning_inputs, staircase_scene, with_fast_planner};
+    use crate::optimise::search::SearchSettings;
+    use crate::optimise::Quality;
+    use crate::physics::{MovementVars, Vec2};
 
     #[test]
     fn the_zigzag_estimate_is_what_alternating_sides_lose_on_a_straight() {
@@ -586,7 +591,6 @@ mod tests {
         // relaxed one's by what the estimate says, to a tenth (here 0.1324 frame estimated, 0.1321 lost).
         let vars = MovementVars::goldsrc(100.0);
         let fl = FrameLaw::of(&vars);
-        assert!(air_law(&vars).gamma1 > 0.0);
         let start = ModelState {
             pos: Vec2::ZERO,
             speed: 320.0,
@@ -632,11 +636,6 @@ mod tests {
             .collect();
         assert!(zigzag_frames(&start, &turning, &fl) < 1e-12);
     }
-    use crate::budget::Budget;
-    use crate::optimise::airborne::LineMargins;
-    use crate::optimise::planner::{planning_inputs, staircase_scene, with_fast_planner};
-    use crate::optimise::search::SearchSettings;
-    use crate::optimise::Quality;
 
     /// A certifier that tried `tried` starts, reached the line at `fractions` (frame 100 at 100 fps, as a
     /// fraction through it), the fastest from start `best_index`.

@@ -17,6 +17,9 @@ pub const ANGLEMOD_STEPS: u32 = 65536;
 /// One anglemod step, degrees: `360 / 65536`.
 const ANGLEMOD_STEP_DEG: f64 = 360.0 / ANGLEMOD_STEPS as f64;
 
+/// One anglemod step, radians: `2 pi / 65536`.
+pub const ANGLEMOD_STEP_RAD: f64 = std::f64::consts::TAU / ANGLEMOD_STEPS as f64;
+
 /// The game's anglemod of a yaw in degrees (docs/physics.md section 1): the angle truncated towards zero to a
 /// multiple of `360/65536` degrees and wrapped into `[0, 360)`. Computed as the game does: the `float`
 /// argument promoted to `double`, the result stored as `float`.

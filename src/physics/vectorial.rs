@@ -13,7 +13,7 @@
 //! (`CL_CreateMove`), which undoes the search: only a replay tool that writes the user command itself plays
 //! such a control, and a scene asks for it (`vectorial-compensation`, off by default).
 
-use super::engine_exact::yaw_on_step_rad;
+use super::engine_exact::{yaw_on_step_rad, ANGLEMOD_STEP_RAD};
 use super::step::Control;
 
 /// Most `|F|` or `|S|` the game transmits, ups (12-bit signed integers).
@@ -44,7 +44,7 @@ pub const VECTORIAL_MAX_WISH_SPEED_UPS: f64 = 1200.0;
 /// yaw on an anglemod step (it survives anglemod unchanged), `F` and `S` whole numbers of ups in
 /// `[-2047, 2047]`, `sqrt(F^2 + S^2)` above [`VECTORIAL_MAX_WISH_SPEED_UPS`]. No jump, no duck.
 pub fn vectorial_strafe(wish_angle_rad: f64) -> Control {
-    let nearest = ((wish_angle_rad + OFFSET_TAN.atan()) / ANGLE_STEP_RAD).round();
+    let nearest = ((wish_angle_rad + OFFSET_TAN.atan()) / ANGLEMOD_STEP_RAD).round();
     let mut best = (f64::INFINITY, yaw_on_step_rad(nearest), 0, 0);
     for j in -YAW_STEPS_TRIED..=YAW_STEPS_TRIED {
         let yaw = yaw_on_step_rad(nearest + j as f64);
@@ -74,25 +74,21 @@ pub fn vectorial_strafe(wish_angle_rad: f64) -> Control {
     }
 }
 
-/// One anglemod step, radians.
-const ANGLE_STEP_RAD: f64 = std::f64::consts::TAU / super::engine_exact::ANGLEMOD_STEPS as f64;
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::physics::engine_exact::{anglemod_deg, engine_wish};
-    use crate::physics::Vec2;
+    use crate::physics::{Vec2, Wish};
 
     /// The angle between two directions, radians, in `[0, pi]`.
     fn between(a: Vec2, b: Vec2) -> f64 {
         a.cross(b).atan2(a.dot(b)).abs()
     }
 
-    /// The wish direction of a control in `f64` (`F f + S s`, docs/physics.md section 5).
-    fn wish_dir(c: &Control) -> Vec2 {
-        let f = Vec2::from_angle(c.yaw_rad);
-        let s = Vec2::new(f.y, -f.x);
-        f * c.forwardmove + s * c.sidemove
+    /// The wish direction of a control (docs/physics.md section 5), in `f64` from its `f64` wish or from
+    /// the game's `f32` one.
+    fn direction(w: Wish<f64>) -> Vec2 {
+        w.direction().unwrap_or_else(|| panic!("no keys"))
     }
 
     #[test]
@@ -115,12 +111,16 @@ mod tests {
             }
             assert!(c.forwardmove.hypot(c.sidemove) > VECTORIAL_MAX_WISH_SPEED_UPS);
             let want = Vec2::from_angle(angle);
-            worst = worst.max(between(wish_dir(&c), want));
+            worst = worst.max(between(direction(c.wish()), want));
             let w = engine_wish(&c);
-            let f = Vec2::new(f64::from(w.forward.x), f64::from(w.forward.y));
-            let s = Vec2::new(f.y, -f.x);
-            let game = f * f64::from(w.forwardmove) + s * f64::from(w.sidemove);
-            worst_f32 = worst_f32.max(between(game, want));
+            let game = Wish {
+                forward: Vec2::new(f64::from(w.forward.x), f64::from(w.forward.y)),
+                forwardmove: f64::from(w.forwardmove),
+                sidemove: f64::from(w.sidemove),
+                jump: w.jump,
+                duck: w.duck,
+            };
+            worst_f32 = worst_f32.max(between(direction(game), want));
         }
         assert!(worst < 1.0e-6, "{worst} rad in f64");
         assert!(
@@ -128,6 +128,6 @@ mod tests {
             "{worst_f32} rad in f32"
         );
         // Far finer than the yaw alone: half an anglemod step is 4.8e-5 rad.
-        assert!(worst < 0.05 * ANGLE_STEP_RAD, "{worst} rad");
+        assert!(worst < 0.05 * ANGLEMOD_STEP_RAD, "{worst} rad");
     }
 }
