@@ -179,6 +179,9 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         }
     }
     let iu = |k: usize, j: usize| control_var[2 * k + j];
+    // With every side fixed (the polish) only `c` moves; such sub-problems are equilibrated (see
+    // [`clarabel_solution`]).
+    let sides_fixed = (0..n).all(|k| iu(k, 0).is_none());
     let nx = 4 * n;
     let nvar = nu + nx + m_w;
     let ix = |k: usize, i: usize| nu + 4 * k + i;
@@ -302,7 +305,18 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         q[is(j)] = sp.slack_weight;
     }
     let cones: Vec<SupportedConeT<f64>> = vec![ZeroConeT(n_eq), NonnegativeConeT(n_ineq)];
-    let solution = match clarabel_solution(&p, &q, &a, &b, &cones, max_iterations, time_limit_s) {
+    let solution = match clarabel_solution(
+        &p,
+        &q,
+        &a,
+        &b,
+        &cones,
+        ClarabelLimits {
+            max_iterations,
+            time_limit_s,
+            equilibrate: sides_fixed,
+        },
+    ) {
         Ok(solution) if solution.x.len() == nvar => solution,
         Ok(_) => {
             return SubStep::failed(SubStepStatus::Failed("solution of the wrong size".into()))
@@ -373,25 +387,36 @@ struct Solution {
     z: Vec<f64>,
 }
 
-/// Clarabel run on `min 0.5 x'Px + q'x  s.t.  Ax + s = b, s in cones` within `max_iterations`
-/// interior-point iterations and `time_limit_s` seconds; the status of a failure.
+/// How long Clarabel may work on a sub-problem, and whether it equilibrates it.
+struct ClarabelLimits {
+    /// Interior-point iterations.
+    max_iterations: u32,
+    /// Seconds (Clarabel's own clock; infinite: no limit).
+    time_limit_s: f64,
+    /// Ruiz equilibration. Off where the sides move (the relaxed stage): there it doubled Clarabel's
+    /// interior-point iterations (about 40 against 20 on the 100 fps bend) and the solve time, for no
+    /// better steps. On where every side is fixed (the polish): on thousands of frames those
+    /// sub-problems took a median of over a hundred iterations without it, many ending at the cap, and
+    /// about half as many with it (docs/design.md, "What a sub-problem costs").
+    equilibrate: bool,
+}
+
+/// Clarabel run on `min 0.5 x'Px + q'x  s.t.  Ax + s = b, s in cones` within `limits`; the status of a
+/// failure.
 fn clarabel_solution(
     p: &CscMatrix<f64>,
     q: &[f64],
     a: &CscMatrix<f64>,
     b: &[f64],
     cones: &[SupportedConeT<f64>],
-    max_iterations: u32,
-    time_limit_s: f64,
+    limits: ClarabelLimits,
 ) -> std::result::Result<Solution, SubStepStatus> {
     let settings: DefaultSettings<f64> = DefaultSettingsBuilder::default()
         .verbose(false)
         .presolve_enable(false)
-        .max_iter(max_iterations)
-        .time_limit(time_limit_s)
-        // Ruiz equilibration off: on these sub-problems it doubled Clarabel's interior-point iterations
-        // (about 40 against 20 on the 100 fps bend) and the solve time, for no better steps.
-        .equilibrate_enable(false)
+        .max_iter(limits.max_iterations)
+        .time_limit(limits.time_limit_s)
+        .equilibrate_enable(limits.equilibrate)
         // A sub-problem is one step of the SCP, linearised again at the next iteration: the step needs
         // the accuracy of the trust region, not of the last digit. Iterative refinement (up to 10 extra
         // KKT solves per interior-point iteration) and gap tolerances of 1e-8 more than doubled the time
