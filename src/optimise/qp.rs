@@ -179,9 +179,6 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         }
     }
     let iu = |k: usize, j: usize| control_var[2 * k + j];
-    // With every side fixed (the polish) only `c` moves; such sub-problems are equilibrated (see
-    // [`clarabel_solution`]).
-    let sides_fixed = (0..n).all(|k| iu(k, 0).is_none());
     let nx = 4 * n;
     let nvar = nu + nx + m_w;
     let ix = |k: usize, i: usize| nu + 4 * k + i;
@@ -305,23 +302,20 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         q[is(j)] = sp.slack_weight;
     }
     let cones: Vec<SupportedConeT<f64>> = vec![ZeroConeT(n_eq), NonnegativeConeT(n_ineq)];
-    let solution = match clarabel_solution(
-        &p,
-        &q,
-        &a,
-        &b,
-        &cones,
-        ClarabelLimits {
-            max_iterations,
-            time_limit_s,
-            equilibrate: sides_fixed,
-        },
-    ) {
+    let problem = ClarabelProblem {
+        p: &p,
+        q: &q,
+        a: &a,
+        b: &b,
+        cones: &cones,
+    };
+    let solution = clarabel_solution(&problem, max_iterations, time_limit_s);
+    let solution = match solution {
         Ok(solution) if solution.x.len() == nvar => solution,
         Ok(_) => {
             return SubStep::failed(SubStepStatus::Failed("solution of the wrong size".into()))
         }
-        Err(status) => return SubStep::failed(status),
+        Err(no) => return SubStep::failed(SubStepStatus::Failed(no.to_string())),
     };
     // The step is judged on what its control changes do: Clarabel meets the dynamics rows only to its
     // feasibility tolerance, and along a chain of thousands of frames their residuals add up.
@@ -387,36 +381,74 @@ struct Solution {
     z: Vec<f64>,
 }
 
-/// How long Clarabel may work on a sub-problem, and whether it equilibrates it.
-struct ClarabelLimits {
-    /// Interior-point iterations.
-    max_iterations: u32,
-    /// Seconds (Clarabel's own clock; infinite: no limit).
-    time_limit_s: f64,
-    /// Ruiz equilibration. Off where the sides move (the relaxed stage): there it doubled Clarabel's
-    /// interior-point iterations (about 40 against 20 on the 100 fps bend) and the solve time, for no
-    /// better steps. On where every side is fixed (the polish): on thousands of frames those
-    /// sub-problems took a median of over a hundred iterations without it, many ending at the cap, and
-    /// about half as many with it (docs/design.md, "What a sub-problem costs").
-    equilibrate: bool,
+/// Why Clarabel gave no usable solution.
+#[derive(Clone, Debug, PartialEq)]
+enum NoSolution {
+    /// It stopped for its numerics: at its iteration cap, with insufficient progress, or a numerical
+    /// error.
+    Numerics(SolverStatus),
+    /// Anything else: a certificate of infeasibility, the time limit, the set-up, a non-finite solution.
+    Other(String),
 }
 
-/// Clarabel run on `min 0.5 x'Px + q'x  s.t.  Ax + s = b, s in cones` within `limits`; the status of a
-/// failure.
+impl std::fmt::Display for NoSolution {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NoSolution::Numerics(status) => write!(f, "{status:?}"),
+            NoSolution::Other(why) => f.write_str(why),
+        }
+    }
+}
+
+/// A sub-problem in Clarabel's form: `min 0.5 x'Px + q'x  s.t.  Ax + s = b, s in cones`.
+struct ClarabelProblem<'a> {
+    p: &'a CscMatrix<f64>,
+    q: &'a [f64],
+    a: &'a CscMatrix<f64>,
+    b: &'a [f64],
+    cones: &'a [SupportedConeT<f64>],
+}
+
+/// Clarabel run on `problem` within `max_iterations`
+/// interior-point iterations and `time_limit_s` seconds. Where it stops for its numerics
+/// ([`NoSolution::Numerics`]) the same problem is solved once more with Ruiz equilibration, in the time
+/// left. Equilibration is not the first try: on these sub-problems it doubled Clarabel's iterations
+/// (about 40 against 20 on the 100 fps bend) for no better steps. But on the polish of thousands of
+/// frames in the law's first case Clarabel ended a third of the sub-problems at its iteration cap, where
+/// the same sub-problems equilibrated take about 80 (docs/design.md, "What a sub-problem costs"); a step
+/// found so is one the trust region need not shrink for.
 fn clarabel_solution(
-    p: &CscMatrix<f64>,
-    q: &[f64],
-    a: &CscMatrix<f64>,
-    b: &[f64],
-    cones: &[SupportedConeT<f64>],
-    limits: ClarabelLimits,
-) -> std::result::Result<Solution, SubStepStatus> {
+    problem: &ClarabelProblem,
+    max_iterations: u32,
+    time_limit_s: f64,
+) -> std::result::Result<Solution, NoSolution> {
+    let started = std::time::Instant::now();
+    match clarabel_run(problem, max_iterations, time_limit_s, false) {
+        Err(NoSolution::Numerics(_)) => {
+            let left_s = time_limit_s - started.elapsed().as_secs_f64();
+            if left_s > 0.0 {
+                clarabel_run(problem, max_iterations, left_s, true)
+            } else {
+                Err(NoSolution::Other("MaxTime".into()))
+            }
+        }
+        other => other,
+    }
+}
+
+/// One Clarabel run of [`clarabel_solution`]'s problem, with Ruiz equilibration or without.
+fn clarabel_run(
+    problem: &ClarabelProblem,
+    max_iterations: u32,
+    time_limit_s: f64,
+    equilibrate: bool,
+) -> std::result::Result<Solution, NoSolution> {
     let settings: DefaultSettings<f64> = DefaultSettingsBuilder::default()
         .verbose(false)
         .presolve_enable(false)
-        .max_iter(limits.max_iterations)
-        .time_limit(limits.time_limit_s)
-        .equilibrate_enable(limits.equilibrate)
+        .max_iter(max_iterations)
+        .time_limit(time_limit_s)
+        .equilibrate_enable(equilibrate)
         // A sub-problem is one step of the SCP, linearised again at the next iteration: the step needs
         // the accuracy of the trust region, not of the last digit. Iterative refinement (up to 10 extra
         // KKT solves per interior-point iteration) and gap tolerances of 1e-8 more than doubled the time
@@ -426,27 +458,28 @@ fn clarabel_solution(
         .tol_gap_rel(SUBPROBLEM_GAP_TOL)
         .tol_feas(SUBPROBLEM_FEAS_TOL)
         .build()
-        .map_err(|e| SubStepStatus::Failed(format!("settings: {e}")))?;
+        .map_err(|e| NoSolution::Other(format!("settings: {e}")))?;
+    let ClarabelProblem { p, q, a, b, cones } = *problem;
     let mut solver = DefaultSolver::new(p, q, a, b, cones, settings)
-        .map_err(|e| SubStepStatus::Failed(format!("setup: {e:?}")))?;
+        .map_err(|e| NoSolution::Other(format!("setup: {e:?}")))?;
     solver.solve();
     let status = match solver.solution.status {
         SolverStatus::Solved => SubStepStatus::Solved { almost: false },
         SolverStatus::AlmostSolved => SubStepStatus::Solved { almost: true },
+        numerics @ (SolverStatus::MaxIterations
+        | SolverStatus::NumericalError
+        | SolverStatus::InsufficientProgress) => return Err(NoSolution::Numerics(numerics)),
         other @ (SolverStatus::PrimalInfeasible
         | SolverStatus::DualInfeasible
         | SolverStatus::AlmostPrimalInfeasible
         | SolverStatus::AlmostDualInfeasible
-        | SolverStatus::MaxIterations
         | SolverStatus::MaxTime
-        | SolverStatus::NumericalError
-        | SolverStatus::InsufficientProgress
         | SolverStatus::CallbackTerminated
-        | SolverStatus::Unsolved) => return Err(SubStepStatus::Failed(format!("{other:?}"))),
+        | SolverStatus::Unsolved) => return Err(NoSolution::Other(format!("{other:?}"))),
     };
     let x = std::mem::take(&mut solver.solution.x);
     if x.iter().any(|v| !v.is_finite()) {
-        return Err(SubStepStatus::Failed("non-finite solution".into()));
+        return Err(NoSolution::Other("non-finite solution".into()));
     }
     Ok(Solution {
         status,
