@@ -56,6 +56,7 @@ fn json_carries_every_documented_key() {
         "short",
         "spread",
         "zigzag_frames",
+        "guard_frames",
     ] {
         assert!(v["relaxed"].get(k).is_some(), "missing relaxed.{k}");
     }
@@ -75,6 +76,8 @@ fn json_carries_every_documented_key() {
         zigzag > 0.05 && zigzag < loss,
         "zigzag {zigzag} of {loss} frames"
     );
+    // At 100 fps with air acceleration 10 the law is in its second case: no guard under the kink.
+    assert_eq!(v["relaxed"]["guard_frames"].as_f64(), Some(0.0));
     for k in [
         "clearance_units",
         "centre_line",

@@ -63,6 +63,10 @@ pub struct SceneRecord {
     pub relaxed_short_starts: Option<usize>,
     /// The plan's time less the relaxed optimum's, frames, for a valid plan.
     pub rounding_loss_frames: Option<f64>,
+    /// The certificate's estimate of the zigzag of alternating sides, frames.
+    pub zigzag_frames: Option<f64>,
+    /// The certificate's estimate of the guard under the law's kink, frames.
+    pub guard_frames: Option<f64>,
     /// The greedy guide that gave the baseline.
     pub greedy_guide: String,
     /// `solve`'s status and the plan's source, or the error.
@@ -98,6 +102,8 @@ impl SceneRecord {
             relaxed_spread_s: None,
             relaxed_short_starts: None,
             rounding_loss_frames: None,
+            zigzag_frames: None,
+            guard_frames: None,
             greedy_guide: String::new(),
             status: String::new(),
         }
@@ -154,6 +160,8 @@ pub fn measure_generated_scene(
         r.relaxed_time_s = Some(c.time);
         r.relaxed_spread_s = Some(c.spread);
         r.relaxed_short_starts = Some(c.short);
+        r.zigzag_frames = c.zigzag_frames;
+        r.guard_frames = c.guard_frames;
         if r.valid {
             let tau = g.scene.frame_time_s();
             r.rounding_loss_frames = r.time_s.map(|t| (t - c.time) / tau);
@@ -204,6 +212,13 @@ pub fn columns() -> Vec<Column> {
         Column {
             name: "rounding loss (frames)",
             value: |r| r.rounding_loss_frames,
+        },
+        Column {
+            name: "rounding loss beyond zigzag and guard",
+            value: |r| {
+                let estimated = r.zigzag_frames? + r.guard_frames?;
+                r.rounding_loss_frames.map(|loss| loss - estimated)
+            },
         },
         Column {
             name: "plan frame less relaxed frame",
@@ -332,6 +347,8 @@ mod tests {
             relaxed_spread_s: None,
             relaxed_short_starts: None,
             rounding_loss_frames: None,
+            zigzag_frames: None,
+            guard_frames: None,
             greedy_guide: String::new(),
             status: String::new(),
         };

@@ -172,18 +172,27 @@ pub fn rounding_loss_frames(scene: &Scene, o: &Outcome) -> Option<f64> {
 }
 
 /// The rounding loss as the text output prints it, frames: behind the relaxed optimum, about how much of
-/// it is the zigzag of alternating sides (`zigzag_frames`, [`crate::optimise::RelaxedCertificate`]);
-/// ahead of it, why: the plan touches a wall (its least clearance `min_clearance_units` is under
+/// it is the zigzag of alternating sides and the guard under the law's kink (`zigzag_frames` and
+/// `guard_frames` of [`crate::optimise::RelaxedCertificate`]; the guard where it costs anything); ahead of
+/// it, why: the plan touches a wall (its least clearance `min_clearance_units` is under
 /// [`CERTIFIED_CLEARANCE_UNITS`], so it is no run of the relaxed problem), or the relaxed optimum found is
 /// a local one.
 fn rounding_loss_text(
     loss_frames: f64,
     min_clearance_units: f64,
     zigzag_frames: Option<f64>,
+    guard_frames: Option<f64>,
 ) -> String {
     let why = if loss_frames >= 0.0 {
+        let guard = guard_frames
+            .filter(|&g| g > 0.0)
+            .map_or(String::new(), |g| {
+                format!(", {g:.3} the guard half an angle step under the law's kink")
+            });
         zigzag_frames.map_or(String::new(), |z| {
-            format!(" (about {z:.3} of it the estimated zigzag of sides alternating at full acceleration)")
+            format!(
+                " (about {z:.3} of it the estimated zigzag of sides alternating at full acceleration{guard})"
+            )
         })
     } else if min_clearance_units < CERTIFIED_CLEARANCE_UNITS {
         " (the plan is ahead: it touches a wall, and the relaxed problem holds only runs clear of the walls)"
@@ -301,17 +310,21 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
                 r.spread
             ),
         };
+        // How much of its frame the relaxed optimum leaves: a plan that loses more crosses a frame later.
+        let left = r.frames as f64 - r.time / scene.frame_time_s();
         s.push_str(&field(
             "relaxed optimum",
             format!(
-                "{:>10.6} s (frame {}; a local optimum: {} of {} starts reached the line, {spread})",
+                "{:>10.6} s (frame {}, {left:.3} of it left; a local optimum: {} of {} starts reached the \
+                 line, {spread})",
                 r.time, r.frames, r.reached, r.starts
             ),
         ));
     }
     if let Some(loss) = rounding_loss_frames(scene, o) {
         let zigzag = o.relaxed.and_then(|r| r.zigzag_frames);
-        let text = rounding_loss_text(loss, o.trace.min_clearance(), zigzag);
+        let guard = o.relaxed.and_then(|r| r.guard_frames);
+        let text = rounding_loss_text(loss, o.trace.min_clearance(), zigzag, guard);
         s.push_str(&field("rounding loss", text));
     }
     if let Some(c) = o.trace.crossing {
@@ -361,15 +374,26 @@ mod tests {
     fn a_plan_ahead_of_the_relaxed_optimum_says_why() {
         // Behind it: the loss alone. Ahead of it, touching a wall (a greedy run sliding along one): not a
         // run of the relaxed problem. Ahead of it, clear of the walls: the relaxed optimum is local.
-        assert_eq!(rounding_loss_text(0.25, 1.0, None), "     0.250 frames");
-        let zigzag = rounding_loss_text(0.169, 1.0, Some(0.15));
+        assert_eq!(
+            rounding_loss_text(0.25, 1.0, None, None),
+            "     0.250 frames"
+        );
+        let zigzag = rounding_loss_text(0.169, 1.0, Some(0.15), Some(0.0));
         assert!(
-            zigzag.starts_with("     0.169 frames (about 0.150 of it the estimated zigzag"),
+            zigzag.starts_with("     0.169 frames (about 0.150 of it the estimated zigzag")
+                && !zigzag.contains("guard"),
             "{zigzag}"
         );
-        let touching = rounding_loss_text(-63.4, 0.0, Some(0.1));
+        let guard = rounding_loss_text(0.83, 1.0, Some(0.011), Some(0.79));
+        assert!(
+            guard.ends_with(
+                "acceleration, 0.790 the guard half an angle step under the law's kink)"
+            ),
+            "{guard}"
+        );
+        let touching = rounding_loss_text(-63.4, 0.0, Some(0.1), Some(0.5));
         assert!(touching.starts_with("   -63.400 frames (") && touching.contains("touches a wall"));
-        let clear = rounding_loss_text(-0.2, 2.0 * CERTIFIED_CLEARANCE_UNITS, None);
+        let clear = rounding_loss_text(-0.2, 2.0 * CERTIFIED_CLEARANCE_UNITS, None, None);
         assert!(
             clear.contains("a local one") && !clear.contains("wall"),
             "{clear}"

@@ -353,6 +353,10 @@ pub struct RelaxedCertificate {
     /// where a frame's side is between them, the exact plan alternates, and each move points half a turn
     /// off the mean heading ([`zigzag_frames`]). `None` where not estimated.
     pub zigzag_frames: Option<f64>,
+    /// About how far, in frames, a replayable plan falls behind the fastest relaxed plan by keeping half
+    /// a step of the replay's strafe angle under the law's kink where that plan sits on it
+    /// ([`guard_frames`]; zero in the law's second case). `None` where not estimated.
+    pub guard_frames: Option<f64>,
 }
 
 /// The zigzag of alternating sides along the relaxed plan `controls` from `start`, in frames at the
@@ -369,6 +373,45 @@ pub fn zigzag_frames(start: &ModelState, controls: &[FrameControl], fl: &FrameLa
         let next = frame(&x, *u, fl, false).0;
         let sigma = u.sigma.clamp(-1.0, 1.0);
         behind_units += next.speed * fl.tau_s * (1.0 - sigma * sigma) * delta * delta / 8.0;
+        x = next;
+    }
+    if x.speed > 0.0 {
+        behind_units / (x.speed * fl.tau_s)
+    } else {
+        0.0
+    }
+}
+
+/// The cost of the guard under the kink along the relaxed plan `controls` from `start`, in frames at the
+/// speed it crosses with. In the law's first case a frame whose `c` is above [`FrameLaw::c_plan_max`]
+/// (half a step of the replay's strafe angle under the kink, docs/physics.md section 6) is played at that
+/// `c` by every plan the replay can follow, and gains less speed. The speed not gained is carried on
+/// frame by frame through the plan's own controls (a slower frame gains a little more in the first case,
+/// so the deficit shrinks), and each frame's deficit moves the plan back by it times the frame time:
+/// about `N^2 tau gamma1 q / 4` units over `N` frames on the kink. An estimate like [`zigzag_frames`]: a
+/// plan can trade some of it for a shorter path.
+pub fn guard_frames(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw) -> f64 {
+    let mut x = *start;
+    let mut deficit_ups = 0.0;
+    let mut behind_units = 0.0;
+    for u in controls {
+        let next = frame(&x, *u, fl, false).0;
+        let slower = ModelState {
+            speed: x.speed - deficit_ups,
+            ..x
+        };
+        let carried = next.speed - frame(&slower, *u, fl, false).0.speed;
+        let guarded_c = fl.c_plan_max(x.speed);
+        let lost = if u.c > guarded_c {
+            next.speed
+                - frame(&x, FrameControl { c: guarded_c, ..*u }, fl, false)
+                    .0
+                    .speed
+        } else {
+            0.0
+        };
+        deficit_ups = (carried + lost).max(0.0);
+        behind_units += deficit_ups * fl.tau_s;
         x = next;
     }
     if x.speed > 0.0 {
@@ -557,11 +600,14 @@ impl Certifier {
             short: self.ends.iter().filter(|e| e.short).count(),
             spread: slowest - best.crossing.time,
             zigzag_frames: None,
+            guard_frames: None,
         })
     }
 
-    /// The certificate with its zigzag estimate ([`zigzag_frames`]) along its fastest plan from `start`.
-    pub(super) fn certificate_with_zigzag(
+    /// The certificate with the estimates of what a replayable exact plan loses against it along its
+    /// fastest plan from `start`: the zigzag of alternating sides ([`zigzag_frames`]) and the guard under
+    /// the kink ([`guard_frames`]).
+    pub(super) fn certificate_with_estimates(
         &self,
         start: &ModelState,
         fl: &FrameLaw,
@@ -569,6 +615,7 @@ impl Certifier {
         let best = self.best.as_ref()?;
         self.certificate().map(|c| RelaxedCertificate {
             zigzag_frames: Some(zigzag_frames(start, &best.controls, fl)),
+            guard_frames: Some(guard_frames(start, &best.controls, fl)),
             ..c
         })
     }
@@ -635,6 +682,53 @@ mod tests {
             .map(|u| FrameControl { sigma: 1.0, ..*u })
             .collect();
         assert!(zigzag_frames(&start, &turning, &fl) < 1e-12);
+    }
+
+    #[test]
+    fn the_guard_estimate_is_what_keeping_under_the_kink_loses_on_a_straight() {
+        // 1000 fps, air acceleration 10 (the law's first case), 3000 frames from 400 ups: the relaxed
+        // straight on the kink against the same straight half an anglemod step under it, each frame's `c`
+        // at its own speed. The guarded run falls behind by what the estimate says, to a hundredth (here
+        // 0.66213 frame either way; charging each frame's loss to the end unchanged would say 0.82).
+        let vars = MovementVars::goldsrc(1000.0);
+        let fl = FrameLaw::of(&vars);
+        assert!(fl.has_kink_guard());
+        let start = ModelState {
+            pos: Vec2::ZERO,
+            speed: 400.0,
+            heading: 0.0,
+        };
+        let run = |c_of: &dyn Fn(f64) -> f64| {
+            let mut x = start;
+            let controls: Vec<FrameControl> = (0..3000)
+                .map(|_| {
+                    let u = FrameControl {
+                        sigma: 0.0,
+                        c: c_of(x.speed),
+                    };
+                    x = frame(&x, u, &fl, false).0;
+                    u
+                })
+                .collect();
+            (controls, x)
+        };
+        let (on_kink, r) = run(&|v| fl.c_max(v));
+        let (_, g) = run(&|v| fl.c_plan_max(v));
+        let behind_frames = (r.pos.length() - g.pos.length()) / (r.speed * fl.tau_s);
+        let estimate = guard_frames(&start, &on_kink, &fl);
+        assert!(
+            estimate > 0.1 && (estimate - behind_frames).abs() < 0.01 * behind_frames,
+            "estimate {estimate} frames, behind {behind_frames} frames"
+        );
+        // A plan under the guard already, or in the law's second case (100 fps), loses nothing to it.
+        let (guarded, _) = run(&|v| fl.c_plan_max(v));
+        assert!(guard_frames(&start, &guarded, &fl) < 1e-12);
+        let fl100 = FrameLaw::of(&MovementVars::goldsrc(100.0));
+        let at_100 = [FrameControl {
+            sigma: 0.0,
+            c: fl100.c_max(400.0),
+        }; 100];
+        assert!(!fl100.has_kink_guard() && guard_frames(&start, &at_100, &fl100) < 1e-12);
     }
 
     /// A certifier that tried `tried` starts, reached the line at `fractions` (frame 100 at 100 fps, as a

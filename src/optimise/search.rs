@@ -497,7 +497,7 @@ fn solve_once(
     Ok(Outcome {
         relaxed: found
             .certifier
-            .certificate_with_zigzag(&planner.start, &planner.fl),
+            .certificate_with_estimates(&planner.start, &planner.fl),
         ..outcome
     })
 }
