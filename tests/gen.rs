@@ -662,6 +662,20 @@ fn bench_generated_gives_a_record_per_scene_and_the_distributions() {
     ] {
         assert!(columns.contains(&c), "{columns:?}");
     }
+    // Where each plan crosses against its relaxed optimum's frame, counted, and how much of that frame
+    // the relaxed optimum leaves, per record (a fraction of a frame).
+    for r in &scenes {
+        let left = r["relaxed_frame_left"].as_f64().unwrap_or(f64::NAN);
+        assert!((0.0..1.0).contains(&left), "{r}");
+    }
+    let (in_frame, behind, past) = (
+        v["in_relaxed_frame"].as_u64().unwrap_or(99),
+        v["behind_relaxed_frame"].as_u64().unwrap_or(99),
+        v["behind_where_estimates_pass_the_frame"]
+            .as_u64()
+            .unwrap_or(99),
+    );
+    assert!(in_frame + behind <= 2 && past <= behind, "{v}");
     let gap = &v["distributions"][1];
     assert_eq!(gap["count"], 2);
     assert!(gap["min"].as_f64() <= gap["median"].as_f64());

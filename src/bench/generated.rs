@@ -67,6 +67,9 @@ pub struct SceneRecord {
     pub zigzag_frames: Option<f64>,
     /// The certificate's estimate of the guard under the law's kink, frames.
     pub guard_frames: Option<f64>,
+    /// How much of its crossing frame the relaxed optimum leaves, frames: a plan that loses more crosses
+    /// a frame later.
+    pub relaxed_frame_left: Option<f64>,
     /// The greedy guide that gave the baseline.
     pub greedy_guide: String,
     /// `solve`'s status and the plan's source, or the error.
@@ -104,6 +107,7 @@ impl SceneRecord {
             rounding_loss_frames: None,
             zigzag_frames: None,
             guard_frames: None,
+            relaxed_frame_left: None,
             greedy_guide: String::new(),
             status: String::new(),
         }
@@ -162,8 +166,9 @@ pub fn measure_generated_scene(
         r.relaxed_short_starts = Some(c.short);
         r.zigzag_frames = c.zigzag_frames;
         r.guard_frames = c.guard_frames;
+        let tau = g.scene.frame_time_s();
+        r.relaxed_frame_left = Some(c.frames as f64 - c.time / tau);
         if r.valid {
-            let tau = g.scene.frame_time_s();
             r.rounding_loss_frames = r.time_s.map(|t| (t - c.time) / tau);
         }
     }
@@ -298,6 +303,23 @@ pub fn distributions(records: &[SceneRecord], columns: &[Column]) -> Vec<Distrib
         .collect()
 }
 
+impl SceneRecord {
+    /// The valid plan's crossing frame less its relaxed optimum's (`None`: no valid plan or no
+    /// certificate): 0 in its frame, negative for a plan ahead of it (one that touches a wall, or a
+    /// local relaxed optimum).
+    pub fn frames_behind_relaxed(&self) -> Option<i64> {
+        let (plan, relaxed) = (self.frames?, self.relaxed_frames?);
+        self.valid.then_some(plan as i64 - relaxed as i64)
+    }
+
+    /// Whether the certificate's estimates of the zigzag and the guard alone take more than its frame
+    /// leaves ([`SceneRecord::relaxed_frame_left`]): then no plan near those estimates crosses in it.
+    pub fn estimates_pass_the_relaxed_frame(&self) -> Option<bool> {
+        let estimated = self.zigzag_frames? + self.guard_frames?;
+        Some(estimated > self.relaxed_frame_left?)
+    }
+}
+
 /// Records for which `pred` holds, and all records.
 pub fn share(records: &[SceneRecord], pred: impl Fn(&SceneRecord) -> bool) -> (usize, usize) {
     (records.iter().filter(|r| pred(r)).count(), records.len())
@@ -319,9 +341,10 @@ mod tests {
         assert_eq!(quantile(&[], 0.5), None);
     }
 
-    #[test]
-    fn distributions_skip_records_without_the_figure() {
-        let rec = |gained: Option<i64>, seconds: f64| SceneRecord {
+    /// A valid plan of 100 frames at 100 fps, `gained` frames on greedy, solved in `seconds`; no
+    /// certificate.
+    fn record(gained: Option<i64>, seconds: f64) -> SceneRecord {
+        SceneRecord {
             scene: "s".to_string(),
             corners: 1,
             width_units: 64,
@@ -349,10 +372,19 @@ mod tests {
             rounding_loss_frames: None,
             zigzag_frames: None,
             guard_frames: None,
+            relaxed_frame_left: None,
             greedy_guide: String::new(),
             status: String::new(),
-        };
-        let records = [rec(Some(3), 1.0), rec(None, 2.0), rec(Some(9), 3.0)];
+        }
+    }
+
+    #[test]
+    fn distributions_skip_records_without_the_figure() {
+        let records = [
+            record(Some(3), 1.0),
+            record(None, 2.0),
+            record(Some(9), 3.0),
+        ];
         let d = distributions(&records, &columns());
         assert_eq!(d[0].column, "frames gained on greedy");
         assert_eq!(d[0].count, 2);
@@ -363,5 +395,36 @@ mod tests {
         let time = d.iter().find(|c| c.column == "solve time (s)");
         assert_eq!(time.map(|c| (c.count, c.median)), Some((3, Some(2.0))));
         assert_eq!(share(&records, |r| r.greedy_valid), (2, 3));
+    }
+
+    #[test]
+    fn a_plan_behind_its_relaxed_frame_says_whether_the_estimates_alone_pass_that_frame() {
+        // The 90-degree bend at 100 fps: the relaxed optimum leaves 0.035 of frame 400, the zigzag
+        // takes about 0.124, and the plan crosses in frame 401.
+        let behind = SceneRecord {
+            frames: Some(401),
+            relaxed_frames: Some(400),
+            relaxed_frame_left: Some(0.035),
+            zigzag_frames: Some(0.124),
+            guard_frames: Some(0.0),
+            ..record(Some(1), 1.0)
+        };
+        assert_eq!(behind.frames_behind_relaxed(), Some(1));
+        assert_eq!(behind.estimates_pass_the_relaxed_frame(), Some(true));
+        // The same estimates with half a frame left, the plan in that frame.
+        let in_frame = SceneRecord {
+            frames: Some(400),
+            relaxed_frame_left: Some(0.5),
+            ..behind.clone()
+        };
+        assert_eq!(in_frame.frames_behind_relaxed(), Some(0));
+        assert_eq!(in_frame.estimates_pass_the_relaxed_frame(), Some(false));
+        // No certificate, or no valid plan: nothing to say.
+        assert_eq!(record(None, 1.0).frames_behind_relaxed(), None);
+        let invalid = SceneRecord {
+            valid: false,
+            ..behind
+        };
+        assert_eq!(invalid.frames_behind_relaxed(), None);
     }
 }

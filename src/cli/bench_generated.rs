@@ -54,6 +54,12 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     let greedy = share(&records, |r| r.greedy_valid);
     let plan = share(&records, |r| r.valid);
     let exact = share(&records, |r| r.engine_exact_valid);
+    let in_frame = share(&records, |r| r.frames_behind_relaxed() == Some(0));
+    let is_behind = |r: &SceneRecord| r.frames_behind_relaxed().is_some_and(|k| k > 0);
+    let behind = share(&records, is_behind);
+    let behind_past_estimates = share(&records, |r| {
+        is_behind(r) && r.estimates_pass_the_relaxed_frame() == Some(true)
+    });
     if args.json {
         let value = serde_json::json!({
             "seed": seed,
@@ -64,6 +70,9 @@ pub fn run(args: &BenchArgs) -> Result<String> {
             "greedy_valid": greedy.0,
             "plan_valid": plan.0,
             "engine_exact_valid": exact.0,
+            "in_relaxed_frame": in_frame.0,
+            "behind_relaxed_frame": behind.0,
+            "behind_where_estimates_pass_the_frame": behind_past_estimates.0,
             "scenes": records,
         });
         return serde_json::to_string(&value)
@@ -84,6 +93,13 @@ pub fn run(args: &BenchArgs) -> Result<String> {
         pct(greedy),
         pct(plan),
         pct(exact)
+    ));
+    out.push_str(&format!(
+        "plan in its relaxed optimum's frame: {}; a frame or more behind it: {}, on {} of them the \
+         estimated zigzag and guard alone take more than that frame leaves\n",
+        pct(in_frame),
+        behind.0,
+        behind_past_estimates.0
     ));
     Ok(out)
 }
