@@ -167,9 +167,9 @@ pub fn measure_generated_scene(
         r.zigzag_frames = c.zigzag_frames;
         r.guard_frames = c.guard_frames;
         let tau = g.scene.frame_time_s();
-        r.relaxed_frame_left = Some(c.frames as f64 - c.time / tau);
+        r.relaxed_frame_left = Some(c.frame_left(tau));
         if r.valid {
-            r.rounding_loss_frames = r.time_s.map(|t| (t - c.time) / tau);
+            r.rounding_loss_frames = r.time_s.map(|t| c.loss_frames(t, tau));
         }
     }
     r.status = format!("{} ({})", out.status, out.source);
@@ -220,10 +220,7 @@ pub fn columns() -> Vec<Column> {
         },
         Column {
             name: "rounding loss beyond zigzag and guard",
-            value: |r| {
-                let estimated = r.zigzag_frames? + r.guard_frames?;
-                r.rounding_loss_frames.map(|loss| loss - estimated)
-            },
+            value: |r| Some(r.rounding_loss_frames? - r.estimated_loss_frames()?),
         },
         Column {
             name: "plan frame less relaxed frame",
@@ -315,8 +312,12 @@ impl SceneRecord {
     /// Whether the certificate's estimates of the zigzag and the guard alone take more than its frame
     /// leaves ([`SceneRecord::relaxed_frame_left`]): then no plan near those estimates crosses in it.
     pub fn estimates_pass_the_relaxed_frame(&self) -> Option<bool> {
-        let estimated = self.zigzag_frames? + self.guard_frames?;
-        Some(estimated > self.relaxed_frame_left?)
+        Some(self.estimated_loss_frames()? > self.relaxed_frame_left?)
+    }
+
+    /// The certificate's estimates of the zigzag and the guard together, frames.
+    fn estimated_loss_frames(&self) -> Option<f64> {
+        Some(self.zigzag_frames? + self.guard_frames?)
     }
 }
 

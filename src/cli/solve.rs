@@ -168,7 +168,7 @@ pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
 /// wall margin and the anglemod steps cost.
 pub fn rounding_loss_frames(scene: &Scene, o: &Outcome) -> Option<f64> {
     let (c, r) = (o.trace.crossing?, o.relaxed?);
-    Some((c.time - r.time) / scene.frame_time_s())
+    Some(r.loss_frames(c.time, scene.frame_time_s()))
 }
 
 /// The rounding loss as the text output prints it, frames: behind the relaxed optimum, about how much of
@@ -310,8 +310,7 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
                 r.spread
             ),
         };
-        // How much of its frame the relaxed optimum leaves: a plan that loses more crosses a frame later.
-        let left = r.frames as f64 - r.time / scene.frame_time_s();
+        let left = r.frame_left(scene.frame_time_s());
         s.push_str(&field(
             "relaxed optimum",
             format!(

@@ -309,8 +309,7 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         b: &b,
         cones: &cones,
     };
-    let solution = clarabel_solution(&problem, max_iterations, time_limit_s);
-    let solution = match solution {
+    let solution = match clarabel_solution(&problem, max_iterations, time_limit_s) {
         Ok(solution) if solution.x.len() == nvar => solution,
         Ok(_) => {
             return SubStep::failed(SubStepStatus::Failed("solution of the wrong size".into()))
@@ -410,9 +409,8 @@ struct ClarabelProblem<'a> {
 }
 
 /// Clarabel run on `problem` within `max_iterations` interior-point iterations and `time_limit_s`
-/// seconds. Where it stops for its numerics
-/// ([`NoSolution::Numerics`]) the same problem is solved once more with Ruiz equilibration, in the time
-/// left. Equilibration is not the first try: on these sub-problems it doubled Clarabel's iterations
+/// seconds. Where it stops for its numerics ([`NoSolution::Numerics`]) the same problem is solved once
+/// more with Ruiz equilibration, in the time left. Equilibration is not the first try: on these sub-problems it doubled Clarabel's iterations
 /// (about 40 against 20 on the 100 fps bend) for no better steps. But on the polish of thousands of
 /// frames in the law's first case Clarabel ended a third of the sub-problems at its iteration cap, where
 /// the same sub-problems equilibrated take about 80 (docs/design.md, "What a sub-problem costs"); a step

@@ -359,6 +359,29 @@ pub struct RelaxedCertificate {
     pub guard_frames: Option<f64>,
 }
 
+impl RelaxedCertificate {
+    /// A plan crossing at `time_s` less the relaxed optimum, in frames of `tau_s` seconds: its rounding
+    /// loss (negative for a plan ahead of it).
+    pub fn loss_frames(&self, time_s: f64, tau_s: f64) -> f64 {
+        (time_s - self.time) / tau_s
+    }
+
+    /// How much of its crossing frame the relaxed optimum leaves, in frames of `tau_s` seconds: a plan
+    /// that loses more to it crosses a frame later.
+    pub fn frame_left(&self, tau_s: f64) -> f64 {
+        self.frames as f64 - self.time / tau_s
+    }
+}
+
+/// `behind_units` of a plan's path in frames at the speed of its last state `end` (zero at rest).
+fn frames_at_end_speed(behind_units: f64, end: &ModelState, tau_s: f64) -> f64 {
+    if end.speed > 0.0 {
+        behind_units / (end.speed * tau_s)
+    } else {
+        0.0
+    }
+}
+
 /// The zigzag of alternating sides along the relaxed plan `controls` from `start`, in frames at the
 /// speed it crosses with: a frame of side `sigma` and full turn `delta` moves `(1 - sigma^2) delta^2 / 8`
 /// of its length less along the track (`1 - cos(delta / 2)` for sides alternating every frame,
@@ -375,11 +398,7 @@ pub fn zigzag_frames(start: &ModelState, controls: &[FrameControl], fl: &FrameLa
         behind_units += next.speed * fl.tau_s * (1.0 - sigma * sigma) * delta * delta / 8.0;
         x = next;
     }
-    if x.speed > 0.0 {
-        behind_units / (x.speed * fl.tau_s)
-    } else {
-        0.0
-    }
+    frames_at_end_speed(behind_units, &x, fl.tau_s)
 }
 
 /// The cost of the guard under the kink along the relaxed plan `controls` from `start`, in frames at the
@@ -414,11 +433,7 @@ pub fn guard_frames(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw
         behind_units += deficit_ups * fl.tau_s;
         x = next;
     }
-    if x.speed > 0.0 {
-        behind_units / (x.speed * fl.tau_s)
-    } else {
-        0.0
-    }
+    frames_at_end_speed(behind_units, &x, fl.tau_s)
 }
 
 /// The certificate's fastest relaxed plan and the start it came from.
@@ -626,6 +641,7 @@ mod tests {
     use super::*;
     use crate::budget::Budget;
     use crate::optimise::airborne::LineMargins;
+    use crate::optimise::model::rollout;
     use crate::optimise::planner::{planning_inputs, staircase_scene, with_fast_planner};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
@@ -662,14 +678,10 @@ mod tests {
                 ..*u
             })
             .collect();
-        let end = |controls: &[FrameControl]| {
-            let mut x = start;
-            for u in controls {
-                x = frame(&x, *u, &fl, false).0;
-            }
-            x
+        let end = |controls: &[FrameControl]| rollout(&start, controls, &fl).last().copied();
+        let (Some(r), Some(e)) = (end(&relaxed), end(&exact)) else {
+            panic!("no frames played");
         };
-        let (r, e) = (end(&relaxed), end(&exact));
         let behind_frames = (r.pos.length() - e.pos.length()) / (r.speed * fl.tau_s);
         let estimate = zigzag_frames(&start, &relaxed, &fl);
         assert!(
@@ -713,7 +725,7 @@ mod tests {
             (controls, x)
         };
         let (on_kink, r) = run(&|v| fl.c_max(v));
-        let (_, g) = run(&|v| fl.c_plan_max(v));
+        let (guarded, g) = run(&|v| fl.c_plan_max(v));
         let behind_frames = (r.pos.length() - g.pos.length()) / (r.speed * fl.tau_s);
         let estimate = guard_frames(&start, &on_kink, &fl);
         assert!(
@@ -721,7 +733,6 @@ mod tests {
             "estimate {estimate} frames, behind {behind_frames} frames"
         );
         // A plan under the guard already, or in the law's second case (100 fps), loses nothing to it.
-        let (guarded, _) = run(&|v| fl.c_plan_max(v));
         assert!(guard_frames(&start, &guarded, &fl) < 1e-12);
         let fl100 = FrameLaw::of(&MovementVars::goldsrc(100.0));
         let at_100 = [FrameControl {

@@ -114,7 +114,7 @@ mod tests {
             worst = worst.max(between(direction(c.wish()), want));
             let w = engine_wish(&c);
             let game = Wish {
-                forward: Vec2::new(f64::from(w.forward.x), f64::from(w.forward.y)),
+                forward: w.forward.to_f64(),
                 forwardmove: f64::from(w.forwardmove),
                 sidemove: f64::from(w.sidemove),
                 jump: w.jump,
