@@ -78,6 +78,16 @@ fn json_carries_every_documented_key() {
     );
     // At 100 fps with air acceleration 10 the law is in its second case: no guard under the kink.
     assert_eq!(v["relaxed"]["guard_frames"].as_f64(), Some(0.0));
+    // Stage 4's replays: the optimised plan is one of the valid ones.
+    let (replays, valid) = (
+        v["stats"]["replays"].as_u64(),
+        v["stats"]["valid_replays"].as_u64(),
+    );
+    assert_eq!(v["source"], "optimised");
+    assert!(
+        matches!((replays, valid), (Some(r), Some(ok)) if ok >= 1 && ok <= r),
+        "replays {replays:?}, valid {valid:?}"
+    );
     for k in [
         "clearance_units",
         "centre_line",

@@ -667,6 +667,18 @@ fn bench_generated_gives_a_record_per_scene_and_the_distributions() {
     for r in &scenes {
         let left = r["relaxed_frame_left"].as_f64().unwrap_or(f64::NAN);
         assert!((0.0..1.0).contains(&left), "{r}");
+        // Its replays: an optimised plan (both scenes' are) is one of the valid ones.
+        let (replays, valid) = (r["replays"].as_u64(), r["valid_replays"].as_u64());
+        assert!(
+            r["status"]
+                .as_str()
+                .is_some_and(|s| s.ends_with("(optimised)")),
+            "{r}"
+        );
+        assert!(
+            matches!((replays, valid), (Some(n), Some(ok)) if ok >= 1 && ok <= n),
+            "{r}"
+        );
     }
     let (in_frame, behind, past) = (
         v["in_relaxed_frame"].as_u64().unwrap_or(99),

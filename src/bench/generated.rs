@@ -70,6 +70,11 @@ pub struct SceneRecord {
     /// How much of its crossing frame the relaxed optimum leaves, frames: a plan that loses more crosses
     /// a frame later.
     pub relaxed_frame_left: Option<f64>,
+    /// Exact-side plans replayed as the game plays them, and how many of those were valid (`solve`'s
+    /// `stats.replays`, `stats.valid_replays`).
+    pub replays: u64,
+    /// See [`SceneRecord::replays`].
+    pub valid_replays: u64,
     /// The greedy guide that gave the baseline.
     pub greedy_guide: String,
     /// `solve`'s status and the plan's source, or the error.
@@ -108,6 +113,8 @@ impl SceneRecord {
             zigzag_frames: None,
             guard_frames: None,
             relaxed_frame_left: None,
+            replays: 0,
+            valid_replays: 0,
             greedy_guide: String::new(),
             status: String::new(),
         }
@@ -158,6 +165,8 @@ pub fn measure_generated_scene(
         .frames
         .filter(|&f| f > 0)
         .map(|f| 1000.0 * r.solve_seconds / f as f64);
+    r.replays = out.stats.replays;
+    r.valid_replays = out.stats.valid_replays;
     r.greedy_guide = out.greedy_guide.to_string();
     if let Some(c) = out.relaxed {
         r.relaxed_frames = Some(c.frames);
@@ -374,6 +383,8 @@ mod tests {
             zigzag_frames: None,
             guard_frames: None,
             relaxed_frame_left: None,
+            replays: 0,
+            valid_replays: 0,
             greedy_guide: String::new(),
             status: String::new(),
         }

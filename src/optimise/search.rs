@@ -196,6 +196,13 @@ pub struct SearchStats {
     pub corrected_steps: u64,
     /// Frame counts tried.
     pub frame_counts_tried: u64,
+    /// Exact-side plans played through the real frame with the wish direction set as the game can set
+    /// it (stage 4's replays; a replay the budget cut is not counted).
+    pub replays: u64,
+    /// Of those, the replays valid in f64 and in the engine-exact mode. Where most are not, the plans
+    /// went off their planned paths when played, and the search polished its lines again at wider
+    /// margins.
+    pub valid_replays: u64,
 }
 
 impl SearchStats {
@@ -207,6 +214,8 @@ impl SearchStats {
         self.rejected_steps += other.rejected_steps;
         self.corrected_steps += other.corrected_steps;
         self.frame_counts_tried += other.frame_counts_tried;
+        self.replays += other.replays;
+        self.valid_replays += other.valid_replays;
     }
 }
 

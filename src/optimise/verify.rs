@@ -109,6 +109,7 @@ pub(super) fn quantised_and_verified(
         planner.note_cut(Stage::Verification);
         return None;
     }
+    planner.stats.replays += 1;
     let t = time_of(&trace);
     if !t.is_finite() {
         return None;
@@ -120,7 +121,9 @@ pub(super) fn quantised_and_verified(
         planner.timed_out = true;
         planner.note_cut(Stage::Verification);
     }
-    run.feasible().then_some((t, trace))
+    let valid = run.feasible();
+    planner.stats.valid_replays += u64::from(valid);
+    valid.then_some((t, trace))
 }
 
 /// The largest distance (units) and speed difference (ups) between `plan` and its replay as verified
@@ -144,8 +147,26 @@ pub(super) fn replay_drift(planner: &Planner, plan: &[FrameControl]) -> (f64, f6
 mod tests {
     use super::*;
     use crate::optimise::model::frame;
-    use crate::optimise::planner::with_fast_planner;
+    use crate::optimise::planner::{staircase_scene, with_fast_planner};
     use crate::scene::Scene;
+
+    #[test]
+    fn every_replay_is_counted_and_only_a_valid_one_as_valid() {
+        with_fast_planner(&staircase_scene(1), |planner, base, _| {
+            // The seed's clean greedy run replays valid; the same number of frames each strafing square
+            // to the velocity on one side (`c = 0`) circles into the walls and never crosses.
+            let seed = planner.warm_start(base.seed());
+            let circling: Vec<FrameControl> = seed
+                .iter()
+                .map(|_| FrameControl { sigma: 1.0, c: 0.0 })
+                .collect();
+            let before = planner.stats;
+            assert!(quantised_and_verified(planner, seed).is_some());
+            assert!(quantised_and_verified(planner, circling).is_none());
+            assert_eq!(planner.stats.replays - before.replays, 2);
+            assert_eq!(planner.stats.valid_replays - before.valid_replays, 1);
+        });
+    }
 
     #[test]
     fn vectorial_compensation_replays_a_plan_on_the_kink_where_yaw_steps_fall_behind() {
