@@ -197,7 +197,7 @@ pub struct SearchStats {
     /// Frame counts tried.
     pub frame_counts_tried: u64,
     /// Exact-side plans played through the real frame with the wish direction set as the game can set
-    /// it (stage 4's replays; a replay the budget cut is not counted).
+    /// it (stage 4's replays; one the budget cut before its f64 run ended is not counted).
     pub replays: u64,
     /// Of those, the replays valid in f64 and in the engine-exact mode. Where most are not, the plans
     /// went off their planned paths when played, and the search polished its lines again at wider
