@@ -410,11 +410,12 @@ struct ClarabelProblem<'a> {
 
 /// Clarabel run on `problem` within `max_iterations` interior-point iterations and `time_limit_s`
 /// seconds. Where it stops for its numerics ([`NoSolution::Numerics`]) the same problem is solved once
-/// more with Ruiz equilibration, in the time left. Equilibration is not the first try: on these sub-problems it doubled Clarabel's iterations
-/// (about 40 against 20 on the 100 fps bend) for no better steps. But on the polish of thousands of
-/// frames in the law's first case Clarabel ended a third of the sub-problems at its iteration cap, where
-/// the same sub-problems equilibrated take about 80 (docs/design.md, "What a sub-problem costs"); a step
-/// found so is one the trust region need not shrink for.
+/// more with Ruiz equilibration, in the time left. Equilibration is not the first try: on these
+/// sub-problems it doubled Clarabel's iterations (about 40 against 20 on the 100 fps bend) for no better
+/// steps. But on the polish of thousands of frames in the law's first case Clarabel ended a third of the
+/// sub-problems at its iteration cap, where the same sub-problems equilibrated take about 80
+/// (docs/design.md, "What a sub-problem costs"); a step found so is one the trust region need not shrink
+/// for.
 fn clarabel_solution(
     problem: &ClarabelProblem,
     max_iterations: u32,
