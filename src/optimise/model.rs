@@ -525,6 +525,17 @@ fn frame_outputs<T: Ad>(x: &ModelState, u: FrameControl, fl: &FrameLaw, frames: 
 /// One frame over [`Ad`] numbers: `(dx, dy, V', psi')` from `(V, psi)` and the control `(c, sigma)`.
 fn one_frame<T: Ad>(v: T, psi: T, c: T, sigma: T, fl: &FrameLaw) -> [T; 4] {
     let AccelLaw { l, gamma1 } = fl.law;
+    // `c = V cos theta` is at most the speed either way. A knot plays one `c` over frames whose speed
+    // changes, so a braking knot's later frames can be asked for `c < -V`: such a frame brakes straight
+    // back (`c = -V`). Taken as it is, `mu c / V` would push harder than `mu` and the frame would gain
+    // speed from nothing.
+    let c = if c.value() < -v.value() {
+        T::constant(0.0) - v
+    } else if c.value() > v.value() {
+        v
+    } else {
+        c
+    };
     // mu = min(gamma1, L - c) when L - c > 0, else 0 (docs/physics.md section 5); the piece is fixed by value.
     let gamma2 = T::constant(l) - c;
     let mu = if gamma2.value() <= 0.0 {
@@ -958,5 +969,43 @@ mod tests {
         );
         // Below the speed at which braking reaches the kink (0.95 V = 2 ups) there is no band.
         assert!(fl.guard_band(2.0).is_none());
+    }
+
+    #[test]
+    fn a_frame_asked_to_brake_harder_than_its_speed_brakes_straight_back() {
+        // `c = V cos theta` cannot pass the speed: a knot's later frames asked for `c < -V` brake as at
+        // `c = -V`, and never gain more than `mu` (taken as it is, `c = -600` at 20 ups would leave at
+        // about 940 ups at 100 fps, 76 at 1000 fps).
+        for fps in [100.0, 1000.0] {
+            let (_, fl) = law(fps);
+            let x = ModelState {
+                pos: Vec2::ZERO,
+                speed: 20.0,
+                heading: 0.4,
+            };
+            let mu = fl.law.gamma1.min(fl.law.l + x.speed);
+            for sigma in [-1.0, 0.3, 1.0] {
+                let asked = frame(&x, FrameControl { sigma, c: -600.0 }, &fl, false).0;
+                let back = frame(&x, FrameControl { sigma, c: -x.speed }, &fl, false).0;
+                assert_eq!(asked, back, "{fps} fps, side {sigma}");
+                assert!(
+                    asked.speed <= x.speed + mu + 1e-9,
+                    "{fps} fps: {}",
+                    asked.speed
+                );
+            }
+            // Its derivative is the speed's: `c` no longer counts.
+            let (_, jac) = frame(
+                &x,
+                FrameControl {
+                    sigma: 1.0,
+                    c: -600.0,
+                },
+                &fl,
+                true,
+            );
+            let jac = jac.unwrap_or_else(|| panic!("no Jacobian"));
+            assert!(jac.b.iter().all(|row| row[1] == 0.0), "{:?}", jac.b);
+        }
     }
 }

@@ -204,8 +204,17 @@ impl ScpProblem<'_> {
                 (0.0, 0.0)
             });
             let dc = trust * C_TRUST_UPS;
+            // A knot plays its `c` over all its frames: it keeps within the braking limit at the knot's
+            // lowest speed (the speed is monotonic over a knot), where a later frame would otherwise be
+            // asked for `c < -V` and only brake straight back ([`super::model`]). A frame's `c` is taken
+            // at the speed it starts from.
+            let lowest_speed = if self.frames_per_knot > 1 {
+                speed.min(lin.states[k].speed)
+            } else {
+                speed
+            };
             let (mut lo, mut hi) = (
-                dc.min(u.c - self.c_min(speed)).max(0.0),
+                dc.min(u.c - self.c_min(lowest_speed)).max(0.0),
                 dc.min(self.c_upper(speed) - u.c).max(0.0),
             );
             if u.c > kink {
