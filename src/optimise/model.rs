@@ -656,6 +656,122 @@ pub fn rollout_knots(
     out
 }
 
+/// Bisection steps of a knot's `c` ([`knots_following`]): the range, under twice the speed wide, down
+/// to under a millionth of an ups.
+const KNOT_FIT_BISECTIONS: usize = 40;
+
+/// How far ahead a knot following a run takes back its lateral offset from the run, in knots' travel
+/// ([`knots_following`]).
+const KNOT_FIT_REACH_KNOTS: f64 = 2.0;
+
+/// Knots of `frames_per_knot` frames that follow the run of `controls` from `start` (the coarse stage's
+/// start from a frame-by-frame run), `c` kept within `c_min` and `c_top(V)`. Each knot's `c` brings the
+/// speed to the run's at the knot's end: the speed does not depend on the side, and grows with `c` up
+/// to the maximum-acceleration `c` (`V'^2 = V^2 + 2 mu c + mu^2`; in the law's second case
+/// `V^2 + L^2 - c^2` above `L - gamma1`), so a bisection finds it. Its side turns the heading to the run's
+/// there: a knot's turn is its side times the turn at `sigma = 1` (`psi' = psi + sigma atan2(lateral,
+/// forward)`, neither depending on the side), plus the turn that takes the knot's lateral offset from
+/// the run back over [`KNOT_FIT_REACH_KNOTS`] knots' travel. Averaging each knot's frames' controls instead
+/// does not follow the run: a frame's turn is not linear in its `c`, so sides alternating at different
+/// `c` turn on average, and the averaged run drifts off its line into the walls.
+pub fn knots_following(
+    start: &ModelState,
+    controls: &[FrameControl],
+    fl: &FrameLaw,
+    frames_per_knot: usize,
+    c_top: impl Fn(f64) -> f64,
+) -> Vec<FrameControl> {
+    let per = frames_per_knot.max(1);
+    let run = rollout(start, controls, fl);
+    let mut here = *start;
+    let mut knots = Vec::with_capacity(controls.len().div_ceil(per));
+    // Every knot plays `per` frames (as the coarse stage plays them); the last aims at the run's end.
+    let frames = u32::try_from(per).unwrap_or(u32::MAX);
+    for (j, chunk) in controls.chunks(per).enumerate() {
+        let first = j * per;
+        let target = run[first + chunk.len() - 1];
+        let c = knot_c_for_speed(&here, fl, frames, target.speed, c_top(here.speed));
+        // The run where this knot starts, and this knot's offset from it, positive to the left.
+        let on_run = if first == 0 { *start } else { run[first - 1] };
+        let offset = Vec2::from_angle(on_run.heading).cross(on_run.pos - here.pos);
+        let reach_units = KNOT_FIT_REACH_KNOTS * per as f64 * fl.tau_s * here.speed.max(1.0);
+        let wanted = target.heading + (offset / reach_units).atan();
+        let sigma = knot_side_for_turn(&here, c, fl, frames, wrapped_rad(wanted - here.heading));
+        let u = FrameControl { sigma, c };
+        here = knot(&here, u, fl, frames, false).0;
+        knots.push(u);
+    }
+    knots
+}
+
+/// The `c` in `[c_min(V), c_top]` of a knot of `frames` frames from `x` that ends nearest to
+/// `target_speed` (ups): the speed at the knot's end grows with `c` (see [`knots_following`]).
+fn knot_c_for_speed(
+    x: &ModelState,
+    fl: &FrameLaw,
+    frames: u32,
+    target_speed: f64,
+    c_top: f64,
+) -> f64 {
+    let speed_at = |c: f64| {
+        knot(x, FrameControl { sigma: 0.0, c }, fl, frames, false)
+            .0
+            .speed
+    };
+    // The braking limit holds at every frame of the knot, so at its end speed, the lowest: the least `c`
+    // at or above `c_min` of the speed it ends at (that speed grows with `c`, so `c - c_min(V_end)` does).
+    let within_limit = |c: f64| c >= fl.c_min(speed_at(c));
+    let mut lo = fl.c_min(x.speed).min(c_top);
+    if !within_limit(lo) {
+        let (mut below, mut above) = (lo, c_top);
+        for _ in 0..KNOT_FIT_BISECTIONS {
+            let mid = 0.5 * (below + above);
+            if within_limit(mid) {
+                above = mid;
+            } else {
+                below = mid;
+            }
+        }
+        lo = above;
+    }
+    let mut hi = c_top;
+    if speed_at(hi) <= target_speed {
+        return hi;
+    }
+    if speed_at(lo) >= target_speed {
+        return lo;
+    }
+    for _ in 0..KNOT_FIT_BISECTIONS {
+        let mid = 0.5 * (lo + hi);
+        if speed_at(mid) < target_speed {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The side in `[-1, 1]` of a knot of `frames` frames from `x` at `c` that turns the heading by
+/// `turn_rad` (as near as the full turn allows): the turn is the side times the turn at `sigma = 1`.
+fn knot_side_for_turn(x: &ModelState, c: f64, fl: &FrameLaw, frames: u32, turn_rad: f64) -> f64 {
+    let full = knot(x, FrameControl { sigma: 1.0, c }, fl, frames, false)
+        .0
+        .heading
+        - x.heading;
+    if full.abs() > f64::EPSILON {
+        (turn_rad / full).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// `angle_rad` wrapped to `[-pi, pi)`.
+fn wrapped_rad(angle_rad: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    (angle_rad + PI).rem_euclid(TAU) - PI
+}
+
 /// The game control that realises `(sigma = +-1, c)` from a velocity `vel`: the strafe angle
 /// `theta = sigma acos(c / |v|)` with full sidemove (docs/physics.md section 5).
 pub fn control_for(vel: Vec2, u: FrameControl, fl: &FrameLaw) -> Control {
@@ -969,6 +1085,93 @@ mod tests {
         );
         // Below the speed at which braking reaches the kink (0.95 V = 2 ups) there is no band.
         assert!(fl.guard_band(2.0).is_none());
+    }
+
+    /// A strafer's run of `frames` frames from `start`, in four stretches: sides alternating at maximum
+    /// acceleration (a straight), a left turn, sides alternating with every right frame braking
+    /// (`c = -V / 2`), and a right turn.
+    fn strafer_run(fl: &FrameLaw, start: &ModelState, frames: usize) -> Vec<FrameControl> {
+        let mut x = *start;
+        let mut controls = Vec::with_capacity(frames);
+        for k in 0..frames {
+            let left = k % 2 == 0;
+            let (sigma, c) = match 4 * k / frames {
+                0 => (if left { 1.0 } else { -1.0 }, fl.c_max(x.speed)),
+                1 => (1.0, fl.c_max(x.speed)),
+                2 if left => (1.0, fl.c_max(x.speed)),
+                2 => (-1.0, -0.5 * x.speed),
+                _ => (-1.0, fl.c_max(x.speed)),
+            };
+            let u = FrameControl { sigma, c };
+            x = frame(&x, u, fl, false).0;
+            controls.push(u);
+        }
+        controls
+    }
+
+    /// The largest distance, units, between the knots' states and the run's at the knots' ends.
+    fn worst_knot_offset(run: &[ModelState], knots: &[ModelState], per: usize) -> f64 {
+        knots
+            .iter()
+            .enumerate()
+            .map(|(j, k)| (k.pos - run[(j * per + per - 1).min(run.len() - 1)].pos).length())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn knots_following_a_run_keep_to_its_line_and_reach_its_speed() {
+        // Both cases of the law (100 fps: the second, 1000 fps: the first), four seconds each, knots of
+        // six and of 25 frames (the last knot shorter).
+        for (fps, per) in [(100.0, 6), (1000.0, 25)] {
+            let (_, fl) = law(fps);
+            let start = ModelState {
+                pos: Vec2::new(10.0, -20.0),
+                speed: 500.0,
+                heading: 0.3,
+            };
+            let controls = strafer_run(&fl, &start, (4.0 * fps) as usize);
+            let run = rollout(&start, &controls, &fl);
+            let knots = knots_following(&start, &controls, &fl, per, |v| fl.c_max(v));
+            assert_eq!(knots.len(), controls.len().div_ceil(per));
+            assert!(knots
+                .iter()
+                .all(|u| u.sigma.abs() <= 1.0 && u.c <= fl.c_max(start.speed) + 1e-9));
+            // Each knot brakes within the limit at every frame it plays: at its end speed too.
+            let mut at = start;
+            for &u in &knots {
+                let next = knot(&at, u, &fl, per as u32, false).0;
+                assert!(
+                    u.c >= fl.c_min(at.speed.min(next.speed)) - 1e-6,
+                    "{fps} fps: {u:?}"
+                );
+                at = next;
+            }
+            let followed = rollout_knots(&start, &knots, &fl, per as u32);
+            let (end, run_end) = (followed[followed.len() - 1], run[run.len() - 1]);
+            // Within 15 units (the narrowest generated corridor leaves its hull 16 either side); measured
+            // 11.4 at 100 fps, where the run brakes to 75 ups, and 0.24 at 1000 fps.
+            let worst = worst_knot_offset(&run, &followed, per);
+            assert!(worst < 15.0, "{fps} fps: {worst} units off the run");
+            assert!((end.speed - run_end.speed).abs() < 1e-6 * run_end.speed);
+            // The same knots with their frames' controls averaged leave the line (77 and 85 units): the
+            // test's run is one that averaging cannot follow.
+            let averaged: Vec<FrameControl> = controls
+                .chunks(per)
+                .map(|ch| FrameControl {
+                    sigma: ch.iter().map(|u| u.sigma).sum::<f64>() / ch.len() as f64,
+                    c: ch.iter().map(|u| u.c).sum::<f64>() / ch.len() as f64,
+                })
+                .collect();
+            let drifted = worst_knot_offset(
+                &run,
+                &rollout_knots(&start, &averaged, &fl, per as u32),
+                per,
+            );
+            assert!(
+                drifted > 50.0,
+                "{fps} fps: averaged knots only {drifted} units off"
+            );
+        }
     }
 
     #[test]

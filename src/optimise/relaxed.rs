@@ -3,9 +3,10 @@
 //! plus a search over N: SCP at a frame count N, then N lowered to the frame before the plan's crossing
 //! until the line can no longer be reached. On long runs (and on the certificate's greedy starts of 200
 //! frames or more) the search first runs over knots of several frames played with one control (coarse to
-//! fine).
+//! fine), each the mean of its frames' controls or, where those knots run into the walls, fitted to
+//! follow the start's run.
 
-use super::model::{frame, rollout_knots, FrameControl, FrameLaw, ModelState};
+use super::model::{frame, knots_following, rollout_knots, FrameControl, FrameLaw, ModelState};
 use super::planner::Planner;
 use super::scp::{model_crossing, ScpProblem};
 use super::search::Progress;
@@ -50,8 +51,10 @@ pub(super) struct Descent {
     pub(super) coarse: CoarseRuns,
     /// Times an unreachable count is grown (by a twentieth, at least two steps) before the search gives up.
     pub(super) grow_tries: usize,
-    /// Where the knots reach no clean line, the problem descended frame by frame before the search's own
-    /// (`None`: the search's own only).
+    /// Where the knots reach no clean line, or were fitted to the run ([`knots_following`]: the averaged
+    /// knots ran into the walls), the problem descended frame by frame before the search's own (`None`:
+    /// the search's own only). A fitted start's line over knots can be a trap far above the line that
+    /// this descent reaches from it.
     pub(super) after_unclear_knots: Option<Relaxation>,
 }
 
@@ -66,8 +69,8 @@ impl Descent {
     /// A certificate's greedy start ([`StartKind::Greedy`]): over knots from 200 frames, and never over
     /// more frames than the run's own. Where its knots reach no clean line (the knots' chords keep a
     /// sagitta's margin, `m^2 tau gamma1 / 8`, which with air acceleration 100 is wider than a sharply
-    /// turning greedy run keeps off the walls), it descends frame by frame in the relaxed plan's problem
-    /// (`planning`, at the planning margin) first: at the certificate's hair-width margin the walls hold
+    /// turning greedy run keeps off the walls), or were fitted to the run, it descends frame by frame in
+    /// the relaxed plan's problem (`planning`, at the planning margin) first: at the certificate's hair-width margin the walls hold
     /// each step back and the count search gains a few frames a count where the wider margin gains tens.
     pub(super) fn greedy_start(planning: Relaxation) -> Descent {
         Descent {
@@ -173,43 +176,35 @@ pub(super) fn relaxed_plan(
     let knot_frames = coarse_knot_frames(n, descent.coarse);
     if knot_frames > 1 {
         let m = knot_frames as usize;
-        let knots: Vec<FrameControl> = controls[..n.min(controls.len())]
-            .chunks(m)
-            .map(|chunk| {
-                let k = chunk.len() as f64;
-                FrameControl {
-                    sigma: chunk.iter().map(|u| u.sigma).sum::<f64>() / k,
-                    c: chunk.iter().map(|u| u.c).sum::<f64>() / k,
-                }
-            })
-            .collect();
         // The chord of a knot leaves its frames' arc by at most the sagitta m^2 tau gamma1 / 8 (each frame
         // turns the heading by at most about gamma1 / V).
         let fl = planner.fl;
         let sagitta = (m * m) as f64 * fl.tau_s * fl.law.gamma1 / 8.0;
+        let over_knots = Relaxation {
+            margin_units: relaxation.margin_units + sagitta,
+            ..relaxation
+        };
+        let (knots, fitted) =
+            coarse_start(planner, &controls[..n.min(controls.len())], m, over_knots);
         let count = knots.len();
-        if let Some(plan) = count_search(
+        let knots_line = count_search(
             planner,
             progress,
             knots,
             count,
             lo / m,
-            descent.count_search(
-                Relaxation {
-                    margin_units: relaxation.margin_units + sagitta,
-                    ..relaxation
-                },
-                knot_frames,
-            ),
+            descent.count_search(over_knots, knot_frames),
         )
-        .line
-        {
+        .line;
+        let reached = knots_line.is_some();
+        if let Some(plan) = knots_line {
             controls = plan
                 .iter()
                 .flat_map(|u| std::iter::repeat_n(*u, m))
                 .collect();
             n = controls.len();
-        } else if let Some(first) = descent.after_unclear_knots {
+        }
+        if let Some(first) = descent.after_unclear_knots.filter(|_| fitted || !reached) {
             let search = descent.count_search(first, 1);
             if let Some(line) =
                 count_search(planner, progress, controls.clone(), n, lo, search).line
@@ -221,6 +216,49 @@ pub(super) fn relaxed_plan(
     }
     let per_frame = descent.count_search(relaxation, 1);
     count_search(planner, progress, controls, n, lo, per_frame)
+}
+
+/// The knots of `frames_per_knot` frames a coarse stage at `relaxation` starts from, for the run of
+/// `controls`: each knot the mean of its frames' controls, which keeps the start's own controls, as long
+/// as those knots keep clear of the walls at the stage's margin; else knots fitted to follow the run
+/// ([`knots_following`]). The mean of alternating sides at different `c` turns on average (a frame's turn
+/// is not linear in its `c`): a greedy run that brakes or turns sharply, averaged, drifts off its line
+/// into the walls, and a stage started inside them stalls.
+fn coarse_start(
+    planner: &Planner,
+    controls: &[FrameControl],
+    frames_per_knot: usize,
+    relaxation: Relaxation,
+) -> (Vec<FrameControl>, bool) {
+    let fl = planner.fl;
+    let averaged: Vec<FrameControl> = controls
+        .chunks(frames_per_knot.max(1))
+        .map(|chunk| {
+            let k = chunk.len() as f64;
+            FrameControl {
+                sigma: chunk.iter().map(|u| u.sigma).sum::<f64>() / k,
+                c: chunk.iter().map(|u| u.c).sum::<f64>() / k,
+            }
+        })
+        .collect();
+    let per = u32::try_from(frames_per_knot).unwrap_or(u32::MAX);
+    let states = rollout_knots(&planner.start, &averaged, &fl, per);
+    if relaxed_problem(planner, relaxation, per).violation(&states)
+        <= super::scp::CLEAN_VIOLATION_UNITS
+    {
+        return (averaged, false);
+    }
+    let c_top = |v: f64| {
+        if relaxation.anglemod_guard {
+            fl.c_plan_max(v)
+        } else {
+            fl.c_max(v)
+        }
+    };
+    (
+        knots_following(&planner.start, controls, &fl, frames_per_knot, c_top),
+        true,
+    )
 }
 
 /// What a count search ends with.
@@ -931,10 +969,10 @@ mod tests {
     #[test]
     fn a_greedy_start_whose_knots_reach_no_clean_line_descends_at_the_planning_margin_first() {
         // Generated scene 23 of seed 97 (CI-sized: 100 fps, air acceleration 10, 66 units wide, a plan
-        // of 354 frames), its second clean greedy run: averaged over knots it runs into the walls, so the
-        // knots reach nothing and the start descends frame by frame. Measured: at the planning margin
-        // first it ends at the plan's 354 frames; at the certificate's margin alone its stages stall
-        // against the walls and the search stops short at 475.
+        // of 354 frames), its second clean greedy run: averaged over knots it runs into the walls, so its
+        // knots are fitted to the run, and their line stops at 484 frames. Measured: descending at the
+        // planning margin first it ends at the plan's 354 frames; at the certificate's margin alone it
+        // stays at 484.
         use crate::scene::generate::{generate, GeneratorSettings};
         let g = generate(97, 23, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
         with_fast_planner(&g.scene, |planner, base, _| {
