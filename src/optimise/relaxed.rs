@@ -70,8 +70,9 @@ impl Descent {
     /// more frames than the run's own. Where its knots reach no clean line (the knots' chords keep a
     /// sagitta's margin, `m^2 tau gamma1 / 8`, which with air acceleration 100 is wider than a sharply
     /// turning greedy run keeps off the walls), or were fitted to the run, it descends frame by frame in
-    /// the relaxed plan's problem (`planning`, at the planning margin) first: at the certificate's hair-width margin the walls hold
-    /// each step back and the count search gains a few frames a count where the wider margin gains tens.
+    /// the relaxed plan's problem (`planning`, at the planning margin) first: at the certificate's
+    /// hair-width margin the walls hold each step back and the count search gains a few frames a count
+    /// where the wider margin gains tens.
     pub(super) fn greedy_start(planning: Relaxation) -> Descent {
         Descent {
             coarse: CoarseRuns::AlsoShort,
@@ -221,9 +222,9 @@ pub(super) fn relaxed_plan(
 /// The knots of `frames_per_knot` frames a coarse stage at `relaxation` starts from, for the run of
 /// `controls`: each knot the mean of its frames' controls, which keeps the start's own controls, as long
 /// as those knots keep clear of the walls at the stage's margin; else knots fitted to follow the run
-/// ([`knots_following`]). The mean of alternating sides at different `c` turns on average (a frame's turn
-/// is not linear in its `c`): a greedy run that brakes or turns sharply, averaged, drifts off its line
-/// into the walls, and a stage started inside them stalls.
+/// ([`knots_following`]); with whether they were fitted. The mean of alternating sides at different `c`
+/// turns on average (a frame's turn is not linear in its `c`): a greedy run that brakes or turns sharply,
+/// averaged, drifts off its line into the walls, and a stage started inside them stalls.
 fn coarse_start(
     planner: &Planner,
     controls: &[FrameControl],
