@@ -656,6 +656,21 @@ pub fn rollout_knots(
     out
 }
 
+/// Knots of `frames_per_knot` frames, each the mean of its frames' `controls` (the last knot's of the
+/// frames left).
+pub fn knots_averaged(controls: &[FrameControl], frames_per_knot: usize) -> Vec<FrameControl> {
+    controls
+        .chunks(frames_per_knot.max(1))
+        .map(|chunk| {
+            let k = chunk.len() as f64;
+            FrameControl {
+                sigma: chunk.iter().map(|u| u.sigma).sum::<f64>() / k,
+                c: chunk.iter().map(|u| u.c).sum::<f64>() / k,
+            }
+        })
+        .collect()
+}
+
 /// Bisection steps of a knot's `c` ([`knots_following`]): the range, under twice the speed wide, down
 /// to under a millionth of an ups.
 const KNOT_FIT_BISECTIONS: usize = 40;
@@ -723,33 +738,31 @@ fn knot_c_for_speed(
     let within_limit = |c: f64| c >= fl.c_min(speed_at(c));
     let mut lo = fl.c_min(x.speed).min(c_top);
     if !within_limit(lo) {
-        let (mut below, mut above) = (lo, c_top);
-        for _ in 0..KNOT_FIT_BISECTIONS {
-            let mid = 0.5 * (below + above);
-            if within_limit(mid) {
-                above = mid;
-            } else {
-                below = mid;
-            }
-        }
-        lo = above;
+        lo = bracket(lo, c_top, within_limit).1;
     }
-    let mut hi = c_top;
-    if speed_at(hi) <= target_speed {
-        return hi;
+    if speed_at(c_top) <= target_speed {
+        return c_top;
     }
     if speed_at(lo) >= target_speed {
         return lo;
     }
+    let (lo, hi) = bracket(lo, c_top, |c| speed_at(c) >= target_speed);
+    0.5 * (lo + hi)
+}
+
+/// Where `holds` (false at `lo`, true at `hi`, and once true for a value, true for every larger one)
+/// turns true, bracketed by bisection ([`KNOT_FIT_BISECTIONS`] halvings): the last value found false and
+/// the first found true.
+fn bracket(mut lo: f64, mut hi: f64, holds: impl Fn(f64) -> bool) -> (f64, f64) {
     for _ in 0..KNOT_FIT_BISECTIONS {
         let mid = 0.5 * (lo + hi);
-        if speed_at(mid) < target_speed {
-            lo = mid;
-        } else {
+        if holds(mid) {
             hi = mid;
+        } else {
+            lo = mid;
         }
     }
-    0.5 * (lo + hi)
+    (lo, hi)
 }
 
 /// The side in `[-1, 1]` of a knot of `frames` frames from `x` at `c` that turns the heading by
@@ -1155,13 +1168,7 @@ mod tests {
             assert!((end.speed - run_end.speed).abs() < 1e-6 * run_end.speed);
             // The same knots with their frames' controls averaged leave the line (77 and 85 units): the
             // test's run is one that averaging cannot follow.
-            let averaged: Vec<FrameControl> = controls
-                .chunks(per)
-                .map(|ch| FrameControl {
-                    sigma: ch.iter().map(|u| u.sigma).sum::<f64>() / ch.len() as f64,
-                    c: ch.iter().map(|u| u.c).sum::<f64>() / ch.len() as f64,
-                })
-                .collect();
+            let averaged = knots_averaged(&controls, per);
             let drifted = worst_knot_offset(
                 &run,
                 &rollout_knots(&start, &averaged, &fl, per as u32),

@@ -6,7 +6,9 @@
 //! fine), each the mean of its frames' controls or, where those knots run into the walls, fitted to
 //! follow the start's run.
 
-use super::model::{frame, knots_following, rollout_knots, FrameControl, FrameLaw, ModelState};
+use super::model::{
+    frame, knots_averaged, knots_following, rollout_knots, FrameControl, FrameLaw, ModelState,
+};
 use super::planner::Planner;
 use super::scp::{model_crossing, ScpProblem};
 use super::search::Progress;
@@ -232,34 +234,17 @@ fn coarse_start(
     relaxation: Relaxation,
 ) -> (Vec<FrameControl>, bool) {
     let fl = planner.fl;
-    let averaged: Vec<FrameControl> = controls
-        .chunks(frames_per_knot.max(1))
-        .map(|chunk| {
-            let k = chunk.len() as f64;
-            FrameControl {
-                sigma: chunk.iter().map(|u| u.sigma).sum::<f64>() / k,
-                c: chunk.iter().map(|u| u.c).sum::<f64>() / k,
-            }
-        })
-        .collect();
+    let averaged = knots_averaged(controls, frames_per_knot);
     let per = u32::try_from(frames_per_knot).unwrap_or(u32::MAX);
     let states = rollout_knots(&planner.start, &averaged, &fl, per);
-    if relaxed_problem(planner, relaxation, per).violation(&states)
-        <= super::scp::CLEAN_VIOLATION_UNITS
-    {
+    let problem = relaxed_problem(planner, relaxation, per);
+    if problem.violation(&states) <= super::scp::CLEAN_VIOLATION_UNITS {
         return (averaged, false);
     }
-    let c_top = |v: f64| {
-        if relaxation.anglemod_guard {
-            fl.c_plan_max(v)
-        } else {
-            fl.c_max(v)
-        }
-    };
-    (
-        knots_following(&planner.start, controls, &fl, frames_per_knot, c_top),
-        true,
-    )
+    let fitted = knots_following(&planner.start, controls, &fl, frames_per_knot, |v| {
+        problem.c_upper(v)
+    });
+    (fitted, true)
 }
 
 /// What a count search ends with.

@@ -264,7 +264,7 @@ impl ScpProblem<'_> {
 
     /// Highest `c` allowed at speed `v`, ups: [`FrameLaw::c_exact_max`] for exact sides that may turn
     /// less; else [`FrameLaw::c_max`], under the anglemod guard when it is on.
-    fn c_upper(&self, v: f64) -> f64 {
+    pub(super) fn c_upper(&self, v: f64) -> f64 {
         if self.turn_less && !self.relaxed {
             self.fl.c_exact_max(v)
         } else if self.anglemod_guard {
