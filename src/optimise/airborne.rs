@@ -129,9 +129,6 @@ pub(super) fn plan_airborne(
             relaxed_found,
         };
     }
-    // A line of the certificate's problem that is another optimum than the relaxed stage's (a greedy
-    // start's, faster by more than the stages can tell apart, or any start's crossing a frame or more
-    // before the fastest plan, or the relaxed line where there is no plan): it is rounded too.
     let same_optimum_s = certifier
         .best()
         .map_or(0.0, |p| same_optimum_s(planner, &p.controls));
@@ -139,26 +136,42 @@ pub(super) fn plan_airborne(
         .as_ref()
         .and_then(|(_, trace)| trace.crossing.map(|c| c.frames))
         .unwrap_or(relaxed_line_frame);
-    // Descending from the plan, the certificate's problem can find a faster line than the relaxed stage
-    // did (it stopped short of its optimum, or in a slower basin): that line is rounded too, and the plan
-    // that comes of it is a start again, so that the certificate stays no slower than the plan.
     let terms = PlanTerms {
         lo,
         margins,
         greedy_s,
     };
-    let faster_line = match certifier.another_optimum(same_optimum_s, frame_to_beat) {
-        Some(plan) => {
-            let line = plan.controls.clone();
-            another_optimum_beside_the_plan_as_start(
-                planner,
-                &mut certifier,
-                line,
-                terms,
-                progress,
-                &mut best,
-            )
-        }
+    // The lines of the certificate's problem rounded too: another optimum than the relaxed stage's (a
+    // greedy start's, faster by more than the stages can tell apart, or any start's crossing a frame or
+    // more before the fastest plan, or the relaxed line where there is no plan), and the fastest greedy
+    // start's line of the plan's frame (the rounding's outcome within a frame depends on its line:
+    // [`Certifier::fastest_greedy_line`]). One is rounded beside the plan as a start: another optimum's
+    // where there is one, the greedy start's line first.
+    let another = certifier
+        .another_optimum(same_optimum_s, frame_to_beat)
+        .map(|p| (p.start_index, p.controls.clone()));
+    let greedy_line = certifier
+        .fastest_greedy_line(frame_to_beat, another.as_ref().map(|a| a.0))
+        .map(|p| p.controls.clone());
+    let (beside, first) = match another {
+        Some((_, line)) => (Some(line), greedy_line),
+        None => (greedy_line, None),
+    };
+    if let Some(line) = first {
+        plans_of_certificate_line(planner, line, terms, progress, &mut best);
+    }
+    // Descending from the plan, the certificate's problem can find a faster line than the relaxed stage
+    // did (it stopped short of its optimum, or in a slower basin): that line is rounded too, and the plan
+    // that comes of it is a start again, so that the certificate stays no slower than the plan.
+    let faster_line = match beside {
+        Some(line) => another_line_beside_the_plan_as_start(
+            planner,
+            &mut certifier,
+            line,
+            terms,
+            progress,
+            &mut best,
+        ),
         None => plan_as_certificate_start(planner, &mut certifier, &best, lo, progress),
     };
     if let Some(line) = faster_line {
@@ -181,12 +194,13 @@ struct PlanTerms {
     greedy_s: f64,
 }
 
-/// The exact plans of `line`, another optimum of the certificate's problem, with the plan so far as the
-/// certificate's start solved beside them on a fork: the two need nothing of each other, and after the
+/// The exact plans of `line`, a line of the certificate's problem other than the relaxed stage's (another
+/// optimum, or a greedy start's line of the plan's frame), with the plan so far as the certificate's start
+/// solved beside them on a fork: the two need nothing of each other, and after the
 /// relaxed stage nothing else keeps the second core busy. Where the rounding gives a faster plan, that
 /// plan is a start too (as the plan so far would have been had the two run one after the other). Returns
 /// the line solved from a plan as a start when it is the certificate's fastest.
-fn another_optimum_beside_the_plan_as_start(
+fn another_line_beside_the_plan_as_start(
     planner: &mut Planner,
     certifier: &mut Certifier,
     line: Vec<FrameControl>,

@@ -474,6 +474,8 @@ pub(super) struct Certifier {
     /// Per start that reached the line, in order.
     ends: Vec<StartEnd>,
     best: Option<CertifiedPlan>,
+    /// The line each greedy start reached ([`StartKind::Greedy`]).
+    greedy_lines: Vec<CertifiedPlan>,
 }
 
 /// Where a start of the certificate ended.
@@ -558,6 +560,13 @@ impl Certifier {
             .best
             .as_ref()
             .is_none_or(|b| crossing.time < b.crossing.time);
+        if matches!(kind, StartKind::Greedy { .. }) {
+            self.greedy_lines.push(CertifiedPlan {
+                controls: controls.clone(),
+                start_index: index,
+                crossing,
+            });
+        }
         if fastest {
             self.best = Some(CertifiedPlan {
                 controls,
@@ -578,6 +587,12 @@ impl Certifier {
             index: e.index + offset,
             ..e
         }));
+        let greedy_lines = other.greedy_lines.into_iter();
+        self.greedy_lines
+            .extend(greedy_lines.map(|p| CertifiedPlan {
+                start_index: p.start_index + offset,
+                ..p
+            }));
         if let Some(plan) = other.best {
             if self
                 .best
@@ -592,6 +607,24 @@ impl Certifier {
             }
         }
         false
+    }
+
+    /// The fastest line a greedy start other than start `except` reached that crosses in frame `frame`
+    /// or before. Where no start
+    /// found another optimum, such a line is no faster than the relaxed plan's own (to within the
+    /// stages' tolerance), but within a frame the rounding's outcome depends on the line it starts from by
+    /// more than the lines' own times differ: rounded from the relaxed plan's line and from a greedy
+    /// start's, plans come out up to 1.7 ms apart (a sixth of a frame at 100 fps), either way round. So
+    /// that line is rounded too, and the plan is the fastest.
+    pub(super) fn fastest_greedy_line(
+        &self,
+        frame: u64,
+        except: Option<usize>,
+    ) -> Option<&CertifiedPlan> {
+        self.greedy_lines
+            .iter()
+            .filter(|p| p.crossing.frames <= frame && Some(p.start_index) != except)
+            .min_by(|a, b| a.crossing.time.total_cmp(&b.crossing.time))
     }
 
     /// The fastest relaxed plan so far.
@@ -793,7 +826,35 @@ mod tests {
                 start_index: best_index,
                 crossing: crossing(fastest),
             }),
+            greedy_lines: Vec::new(),
         }
+    }
+
+    #[test]
+    fn the_greedy_line_of_a_frame_is_the_fastest_greedy_starts_line_crossing_in_it_or_before() {
+        let line = |index: usize, frame: u64, fraction: f64| CertifiedPlan {
+            controls: vec![FrameControl { sigma: 1.0, c: 0.0 }],
+            start_index: index,
+            crossing: Crossing::new(frame, fraction, 0.01),
+        };
+        // The relaxed plan's start (no greedy line), then two greedy starts solved apart.
+        let mut certifier = certifier_of(1, &[0.5], 0);
+        let mut side = certifier_of(2, &[0.6, 0.2], 0);
+        side.greedy_lines = vec![line(0, 100, 0.6), line(1, 101, 0.2)];
+        certifier.absorb(side);
+        let by =
+            |c: &Certifier, frame: u64| c.fastest_greedy_line(frame, None).map(|p| p.start_index);
+        // Their indices follow the relaxed plan's start; none crosses before frame 100.
+        assert_eq!(by(&certifier, 99), None);
+        assert_eq!(by(&certifier, 100), Some(1));
+        // Frame 101's line is later than frame 100's.
+        assert_eq!(by(&certifier, 101), Some(1));
+        // A faster line of the same frame is the one.
+        certifier.greedy_lines.push(line(3, 100, 0.1));
+        assert_eq!(by(&certifier, 100), Some(3));
+        // Unless it is the line rounded anyway (another optimum's).
+        let except = certifier.fastest_greedy_line(100, Some(3));
+        assert_eq!(except.map(|p| p.start_index), Some(1));
     }
 
     #[test]
