@@ -94,7 +94,6 @@ fn json_carries_every_documented_key() {
         "lookahead_units",
         "speed_cap_ups",
         "corner_bend_units",
-        "corners_wrapped",
     ] {
         assert!(
             v["greedy"]["guide"].get(k).is_some(),

@@ -56,9 +56,6 @@ pub struct GreedyGuide {
     /// The width of the bends, units for the hull centre, whose arcs' speeds the strafer keeps under
     /// through each corner of its guide (and brakes for before it), if it does.
     pub corner_bend_units: Option<f64>,
-    /// Whether those corners take every vertex with which the guide wraps one grown wall corner as one
-    /// corner ([`GuidePath::wrap_span_units`]), not only those within [`CORNER_SPAN_UNITS`].
-    pub corners_wrapped: bool,
     /// Whether the strafer turns as sharply as its target needs (uncapped; see
     /// [`Greedy::with_sharp_turns`]).
     pub sharp_turns: bool,
@@ -85,9 +82,6 @@ impl std::fmt::Display for GreedyGuide {
         }
         if let Some(w) = self.corner_bend_units {
             write!(f, ", corner speeds of {w:.0}-unit bends")?;
-            if self.corners_wrapped {
-                write!(f, " (a wrapped corner as one)")?;
-            }
         }
         if self.sharp_turns {
             write!(f, ", turning as sharply as it needs")?;
@@ -149,8 +143,8 @@ pub(super) fn corner_caps(scene: &Scene, path: &[Vec2]) -> Vec<f64> {
 /// several points is wrapped by several vertices).
 const CORNER_SPAN_UNITS: f64 = 64.0;
 
-/// A corner of a guide path: the vertices that bend the same way within a span of each other
-/// ([`CORNER_SPAN_UNITS`], or a guide's [`GuidePath::wrap_span_units`]).
+/// A corner of a guide path: the vertices that bend the same way within [`CORNER_SPAN_UNITS`] of each
+/// other.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct PathCorner {
     /// Arc length of its first vertex along the path, units.
@@ -161,9 +155,8 @@ struct PathCorner {
     turn_rad: f64,
 }
 
-/// The corners of the polyline `path`, in order: vertices that bend the same way less than `span_units`
-/// apart are one corner.
-fn path_corners(path: &[Vec2], span_units: f64) -> Vec<PathCorner> {
+/// The corners of the polyline `path`, in order.
+fn path_corners(path: &[Vec2]) -> Vec<PathCorner> {
     let mut corners: Vec<PathCorner> = Vec::new();
     let mut s = 0.0;
     for w in path.windows(3) {
@@ -171,7 +164,7 @@ fn path_corners(path: &[Vec2], span_units: f64) -> Vec<PathCorner> {
         s += a.length();
         let turn = a.cross(b).atan2(a.dot(b));
         match corners.last_mut() {
-            Some(c) if c.turn_rad * turn > 0.0 && a.length() < span_units => {
+            Some(c) if c.turn_rad * turn > 0.0 && a.length() < CORNER_SPAN_UNITS => {
                 c.turn_rad += turn;
                 c.last_units = s;
             }
@@ -189,7 +182,7 @@ fn path_corners(path: &[Vec2], span_units: f64) -> Vec<PathCorner> {
 
 /// The largest turn of the polyline `path` at one corner, radians (see [`path_corners`]).
 fn sharpest_corner_rad(path: &[Vec2]) -> f64 {
-    path_corners(path, CORNER_SPAN_UNITS)
+    path_corners(path)
         .iter()
         .map(|c| c.turn_rad.abs())
         .fold(0.0, f64::max)
@@ -200,9 +193,9 @@ fn sharpest_corner_rad(path: &[Vec2]) -> f64 {
 /// largest arc through a bend of that width and the corner's turn, over that arc (its tangent length
 /// `r tan(turn / 2)`, at most `r`, either side of the corner), and before it what braking at `gamma1` a
 /// frame (section 7) can bring down to it. A corner whose arc needs more than `sv_maxvelocity` does not
-/// limit. Vertices less than `span_units` apart are one corner ([`path_corners`]).
-fn corner_speeds(scene: &Scene, path: &[Vec2], width_units: f64, span_units: f64) -> CornerSpeeds {
-    let corners = path_corners(path, span_units)
+/// limit.
+fn corner_speeds(scene: &Scene, path: &[Vec2], width_units: f64) -> CornerSpeeds {
+    let corners = path_corners(path)
         .iter()
         .filter_map(|c| {
             let turn = c.turn_rad.abs();
@@ -245,31 +238,6 @@ struct GuidePath {
     path: Vec<Vec2>,
 }
 
-impl GuidePath {
-    /// The span within which this guide's vertices wrap one corner of the walls, units: the walls grown
-    /// by the hull's half width and the clearance, `h`, turn a wall's corner into a square's of side
-    /// `2 h`, and the guide can bend at both of that side's ends (16 units off the walls: 64 units
-    /// apart); [`WRAP_TOL_UNITS`] more so that the side itself counts, and at least
-    /// [`CORNER_SPAN_UNITS`].
-    fn wrap_span_units(&self) -> f64 {
-        let side = 2.0 * (HULL_HALF_WIDTH_UNITS + self.clearance_units);
-        (side + WRAP_TOL_UNITS).max(CORNER_SPAN_UNITS)
-    }
-
-    /// The span the corners along this guide group its vertices within: [`Self::wrap_span_units`] when
-    /// `corners_wrapped`, else [`CORNER_SPAN_UNITS`].
-    fn corner_span_units(&self, corners_wrapped: bool) -> f64 {
-        if corners_wrapped {
-            self.wrap_span_units()
-        } else {
-            CORNER_SPAN_UNITS
-        }
-    }
-}
-
-/// See [`GuidePath::wrap_span_units`], units.
-const WRAP_TOL_UNITS: f64 = 1.0;
-
 /// How a greedy run takes corners its maximum-acceleration turn cannot: keeping its speed down (a speed
 /// cap held once reached, or the corner speeds of bends of a width, units for the hull centre), or
 /// turning harder than maximum acceleration as its target needs.
@@ -277,11 +245,6 @@ const WRAP_TOL_UNITS: f64 = 1.0;
 enum Cornering {
     Cap(f64),
     CornerSpeeds(f64),
-    /// Corner speeds with each wrapped corner of the guide one corner ([`GuidePath::wrap_span_units`]):
-    /// a guide far off the walls wraps a sharp corner with vertices farther apart than
-    /// [`CORNER_SPAN_UNITS`], and that corner split in two asks for the speeds of two gentler turns.
-    /// Played beside the split corners, whose faster runs can be the valid ones.
-    WrappedCornerSpeeds(f64),
     SharpTurns,
 }
 
@@ -412,14 +375,10 @@ pub(super) fn baseline(
 }
 
 /// The airborne ways of keeping the speed down for corners along `path`: the speed caps
-/// ([`corner_caps`]), then the corner speeds of bends of each of [`CAP_WIDTHS_UNITS`], split and wrapped.
+/// ([`corner_caps`]), then the corner speeds of bends of each of [`CAP_WIDTHS_UNITS`].
 fn speed_limits(scene: &Scene, path: &[Vec2]) -> impl Iterator<Item = Cornering> {
     let caps = corner_caps(scene, path).into_iter().map(Cornering::Cap);
-    let split = CAP_WIDTHS_UNITS.iter().map(|&w| Cornering::CornerSpeeds(w));
-    let wrapped = CAP_WIDTHS_UNITS
-        .iter()
-        .map(|&w| Cornering::WrappedCornerSpeeds(w));
-    caps.chain(split).chain(wrapped)
+    caps.chain(CAP_WIDTHS_UNITS.iter().map(|&w| Cornering::CornerSpeeds(w)))
 }
 
 /// The verdicts of the greedy runs swept so far, each as its crossing time (or rank), guide index and
@@ -451,19 +410,18 @@ fn strafer(path: &[Vec2], guide: &GreedyGuide, corners: Option<&CornerSpeeds>) -
 }
 
 /// The strafer of `guide` along `path`, its corner speeds worked out for it.
-fn strafer_of(sim: &Simulation, path: &GuidePath, guide: &GreedyGuide) -> Greedy {
-    let span = path.corner_span_units(guide.corners_wrapped);
+fn strafer_of(sim: &Simulation, path: &[Vec2], guide: &GreedyGuide) -> Greedy {
     let corners = guide
         .corner_bend_units
-        .map(|w| corner_speeds(sim.scene(), &path.path, w, span));
-    strafer(&path.path, guide, corners.as_ref())
+        .map(|w| corner_speeds(sim.scene(), path, w));
+    strafer(path, guide, corners.as_ref())
 }
 
 /// Run `i`'s guide played again whole.
 fn replay(sim: &Simulation, guides: &[GuidePath], i: usize, guide: GreedyGuide) -> GuideRun {
     GuideRun {
         guide,
-        trace: sim.run(&mut strafer_of(sim, &guides[i], &guide)),
+        trace: sim.run(&mut strafer_of(sim, &guides[i].path, &guide)),
     }
 }
 
@@ -489,22 +447,9 @@ fn sweep_guides(
         .into_iter()
         .chain(cornering.iter().copied().map(Some))
         .flat_map(|way| {
-            let limited = matches!(
-                way,
-                Some(
-                    Cornering::Cap(_)
-                        | Cornering::CornerSpeeds(_)
-                        | Cornering::WrappedCornerSpeeds(_)
-                )
-            );
-            // Wrapped corners only where the guide's wrap spans more than the split corners' span
-            // (elsewhere they are the same corners, and the same runs).
-            let wraps = move |i: usize| {
-                !matches!(way, Some(Cornering::WrappedCornerSpeeds(_)))
-                    || guides[i].wrap_span_units() > CORNER_SPAN_UNITS
-            };
+            let limited = matches!(way, Some(Cornering::Cap(_) | Cornering::CornerSpeeds(_)));
             (0..guides.len())
-                .filter(move |&i| (!limited || i == 0 || i == last) && wraps(i))
+                .filter(move |&i| !limited || i == 0 || i == last)
                 .map(move |i| (way, i))
         })
         .collect();
@@ -553,16 +498,12 @@ fn sweep_guide(
     let (cap, corner_bend_units, sharp_turns) = match way {
         None => (None, None, false),
         Some(Cornering::Cap(cap)) => (Some(cap), None, false),
-        Some(Cornering::CornerSpeeds(w) | Cornering::WrappedCornerSpeeds(w)) => {
-            (None, Some(w), false)
-        }
+        Some(Cornering::CornerSpeeds(w)) => (None, Some(w), false),
         Some(Cornering::SharpTurns) => (None, None, true),
     };
-    let corners_wrapped = matches!(way, Some(Cornering::WrappedCornerSpeeds(_)));
     let g = &guides[i];
     // The corner speeds along this guide, the same at every look-ahead.
-    let span = g.corner_span_units(corners_wrapped);
-    let corners = corner_bend_units.map(|w| corner_speeds(sim.scene(), &g.path, w, span));
+    let corners = corner_bend_units.map(|w| corner_speeds(sim.scene(), &g.path, w));
     let mut swept = GuideSweep {
         clean: None,
         valid: None,
@@ -582,7 +523,6 @@ fn sweep_guide(
             lookahead_units: la,
             speed_cap_ups: cap,
             corner_bend_units,
-            corners_wrapped,
             sharp_turns,
         };
         let run = sim.run_summary_broken_until(
@@ -651,7 +591,7 @@ fn pick_greedy(
         (Some(&(_, i, guide)), _) => replay(sim, guides, i, guide),
         (None, Some((_, i, guide))) => GuideRun {
             guide,
-            trace: sim.run_within(&mut strafer_of(sim, &guides[i], &guide), budget),
+            trace: sim.run_within(&mut strafer_of(sim, &guides[i].path, &guide), budget),
         },
         (None, None) => {
             let guide = GreedyGuide {
@@ -660,12 +600,11 @@ fn pick_greedy(
                 lookahead_units: GREEDY_LOOKAHEADS_UNITS[0],
                 speed_cap_ups: None,
                 corner_bend_units: None,
-                corners_wrapped: false,
                 sharp_turns: false,
             };
             GuideRun {
                 guide,
-                trace: sim.run_within(&mut strafer_of(sim, &guides[0], &guide), budget),
+                trace: sim.run_within(&mut strafer_of(sim, &guides[0].path, &guide), budget),
             }
         }
     };
@@ -706,7 +645,7 @@ mod tests {
         let sharpest = sharpest_corner_rad(&path);
         assert!((sharpest - 150f64.to_radians()).abs() < 1e-9, "{sharpest}");
         // The corners in order, where they start and end along the path, and their turns.
-        let corners = path_corners(&path, CORNER_SPAN_UNITS);
+        let corners = path_corners(&path);
         assert_eq!(corners.len(), 2, "{corners:?}");
         let want = [(500.0, 520.0, 150.0), (1030.0, 1030.0, -60.0)];
         for (c, (first, last, turn)) in corners.iter().zip(want) {
@@ -717,71 +656,14 @@ mod tests {
     }
 
     #[test]
-    fn a_guide_far_off_the_walls_takes_a_corner_it_wraps_as_one() {
-        // A 125-degree left turn wrapped by two bends of 62.5 degrees 72 units apart (a guide 16 units
-        // off the walls bends at both ends of the grown corner's side, 2 x (16 + 16) = 64 units, or a
-        // little more where it leaves the corner at an angle), then 600 units on.
-        let mut path = vec![Vec2::new(-600.0, 0.0), Vec2::new(0.0, 0.0)];
-        let turn = 62.5f64.to_radians();
-        path.push(Vec2::from_angle(turn) * 72.0);
-        let last = path[path.len() - 1];
-        path.push(last + Vec2::from_angle(2.0 * turn) * 600.0);
-        let guide = |clearance_units: f64| GuidePath {
-            clearance_units,
-            centre_line: false,
-            path: path.clone(),
-        };
-        // Split at the drawn corners' span: two gentler turns.
-        assert_eq!(path_corners(&path, CORNER_SPAN_UNITS).len(), 2);
-        // Wrapped, along a guide wide enough to bend that far apart: one turn of 125 degrees.
-        let wide = guide(24.0);
-        assert!((wide.wrap_span_units() - 81.0).abs() < 1e-9);
-        let wrapped = path_corners(&path, wide.corner_span_units(true));
-        assert_eq!(wrapped.len(), 1, "{wrapped:?}");
-        assert!(
-            (wrapped[0].turn_rad - 2.0 * turn).abs() < 1e-9,
-            "{wrapped:?}"
-        );
-        // Along the shortest path (the hull's own half width) the span is the drawn corners' own.
-        assert!((guide(0.0).wrap_span_units() - CORNER_SPAN_UNITS).abs() < 1e-12);
-    }
-
-    #[test]
-    fn where_the_split_corners_ask_for_too_much_speed_the_wrapped_ones_seed_the_search() {
-        // Generated scene 5 of seed 2718 (100 fps, 4 corners): its guide 16 units off the walls wraps a
-        // 125-degree corner with vertices about 64 units apart. Measured: the fastest clean run is the
-        // strafer with that corner as one (492 frames); with the corner split in two its corner speeds
-        // (555 to 597 ups where the whole corner needs 297) are never clean, and the fastest clean
-        // run without it is a speed-capped one of 663 frames.
-        use crate::scene::generate::{generate, GeneratorSettings};
-        let settings = GeneratorSettings {
-            fps: vec![100, 250],
-            max_corners: 4,
-            ..GeneratorSettings::default()
-        };
-        let g = generate(2718, 5, &settings).unwrap_or_else(|e| panic!("{e}"));
-        let (_, _, base) = planning_inputs(&g.scene);
-        let frames = |r: &GuideRun| r.trace.crossing.map_or(u64::MAX, |c| c.frames);
-        let seed = base.clean.first().unwrap_or_else(|| panic!("no clean run"));
-        assert!(seed.guide.corners_wrapped, "{}", seed.guide);
-        let split = base.clean.iter().find(|r| !r.guide.corners_wrapped);
-        let split_frames = split.map_or(u64::MAX, frames);
-        assert!(
-            frames(seed) + 100 < split_frames,
-            "{} against {split_frames}",
-            frames(seed)
-        );
-    }
-
-    #[test]
     fn each_corner_has_the_speed_of_its_own_arc_over_its_tangent_lengths() {
         // A staircase of right-angle turns; its shortest path cuts each corner's diagonal a little
         // differently, so each corner has its own turn and speed.
         let scene = staircase_scene(3);
         let (_, bound, _) = planning_inputs(&scene);
         let width = 64.0;
-        let corners = path_corners(&bound.path, CORNER_SPAN_UNITS);
-        let speeds = corner_speeds(&scene, &bound.path, width, CORNER_SPAN_UNITS);
+        let corners = path_corners(&bound.path);
+        let speeds = corner_speeds(&scene, &bound.path, width);
         assert_eq!((corners.len(), speeds.corners.len()), (3, 3), "{speeds:?}");
         for (c, corner) in speeds.corners.iter().zip(&corners) {
             let turn = corner.turn_rad.abs();
