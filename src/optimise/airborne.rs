@@ -196,10 +196,10 @@ struct PlanTerms {
 
 /// The exact plans of `line`, a line of the certificate's problem other than the relaxed stage's (another
 /// optimum, or a greedy start's line of the plan's frame), with the plan so far as the certificate's start
-/// solved beside them on a fork: the two need nothing of each other, and after the
-/// relaxed stage nothing else keeps the second core busy. Where the rounding gives a faster plan, that
-/// plan is a start too (as the plan so far would have been had the two run one after the other). Returns
-/// the line solved from a plan as a start when it is the certificate's fastest.
+/// solved beside them on a fork: the two need nothing of each other, and after the relaxed stage nothing
+/// else keeps the second core busy. Where the rounding gives a faster plan, that plan is a start too (as
+/// the plan so far would have been had the two run one after the other). Returns the line solved from a
+/// plan as a start when it is the certificate's fastest.
 fn another_line_beside_the_plan_as_start(
     planner: &mut Planner,
     certifier: &mut Certifier,

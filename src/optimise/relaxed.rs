@@ -610,12 +610,11 @@ impl Certifier {
     }
 
     /// The fastest line a greedy start other than start `except` reached that crosses in frame `frame`
-    /// or before. Where no start
-    /// found another optimum, such a line is no faster than the relaxed plan's own (to within the
-    /// stages' tolerance), but within a frame the rounding's outcome depends on the line it starts from by
-    /// more than the lines' own times differ: rounded from the relaxed plan's line and from a greedy
-    /// start's, plans come out up to 0.9 ms apart (near a tenth of a frame at 100 fps), either way round. So
-    /// that line is rounded too, and the plan is the fastest.
+    /// or before. Where no start found another optimum, such a line is no faster than the relaxed plan's
+    /// own (to within the stages' tolerance), but within a frame the rounding's outcome depends on the
+    /// line it starts from by more than the lines' own times differ: rounded from the relaxed plan's line
+    /// and from a greedy start's, plans come out up to 0.9 ms apart (near a tenth of a frame at 100 fps),
+    /// either way round. So that line is rounded too, and the plan is the fastest.
     pub(super) fn fastest_greedy_line(
         &self,
         frame: u64,
