@@ -245,8 +245,10 @@ impl<'a> Planner<'a> {
             // A greedy run brakes straight back (`c = -V`), beyond the plan's range, where the frame's
             // heading is singular in `c` (`sqrt(V^2 - c^2)`): the relaxed frame there keeps its sides
             // cancelled (`sigma = 0`, the same move) so that raising `c` into the range does not swing
-            // the heading by more than its linearisation sees.
-            if u.c < fl.c_min(v) {
+            // the heading by more than its linearisation sees. A frame below the range that turns (a
+            // greedy run braking into a corner, a plan's frame after the game's quantised angles) keeps
+            // its side: cancelled, its push sideways is lost and the run replays off its path.
+            if u.c < fl.c_min(v) && braking_straight_back(u.c, v, &fl) {
                 u.sigma = 0.0;
             }
             warm.push(u);
@@ -254,6 +256,14 @@ impl<'a> Planner<'a> {
         }
         warm
     }
+}
+
+/// Whether a frame of strafe cosine `c / v` (speed `v`, ups) pushes straight back to within one step of
+/// the replay's strafe angle: `sin theta < q`, `q` = [`super::model::AngleControl::step_rad`]
+/// (docs/physics.md section 1), so that its side moves the player by less than the game can resolve.
+fn braking_straight_back(c: f64, v: f64, fl: &FrameLaw) -> bool {
+    let step = v * fl.angle_control.step_rad();
+    v * v - c * c < step * step
 }
 
 /// The finish line's unit normal pointing the way the shortest path crosses it.
@@ -330,14 +340,14 @@ mod tests {
     use crate::scene::generate::{generate, GeneratorSettings};
 
     #[test]
-    fn a_warm_start_braking_straight_back_cancels_its_sides_and_keeps_the_run() {
+    fn a_warm_start_cancels_the_sides_of_frames_braking_straight_back_only() {
         // Generated scene 12 of seed 11: 1472 ups into a turn, so the capped greedy runs brake first.
         let g = generate(11, 12, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
         let scene = g.scene;
         let (sim, bound, base) = planning_inputs(&scene);
         let budget = Budget::unlimited();
         let settings = SearchSettings::for_quality(crate::optimise::Quality::Fast);
-        let (mut braked, mut held) = (0, 0);
+        let (mut braked, mut braked_turning, mut held) = (0, 0, 0);
         for run in &base.clean {
             let planner = Planner::new(&scene, &sim, &settings, &bound, &run.trace, budget);
             let warm = planner.warm_start(&run.trace);
@@ -346,8 +356,15 @@ mod tests {
             for (k, (u, rec)) in warm.iter().zip(&run.trace.frames).enumerate() {
                 let game = crate::optimise::model::frame_control_of(vel, &run.trace.controls[k]);
                 if game.c < planner.fl.c_min(vel.length()) {
-                    braked += 1;
-                    assert_eq!(u.sigma, 0.0, "frame {k}");
+                    // Straight back, the side cancelled; braking into a corner while turning, the
+                    // side kept.
+                    if braking_straight_back(game.c, vel.length(), &planner.fl) {
+                        braked += 1;
+                        assert_eq!(u.sigma, 0.0, "frame {k}");
+                    } else {
+                        braked_turning += 1;
+                        assert_eq!(u.sigma, game.sigma, "frame {k}");
+                    }
                 }
                 // Each frame's `c` is the run's, no more than the plan's largest.
                 let c_max = planner.fl.c_plan_max(vel.length());
@@ -363,6 +380,79 @@ mod tests {
             held += usize::from(run.guide.speed_cap_ups.is_some());
         }
         assert!(braked > 0, "no clean run braked straight back");
+        assert!(braked_turning > 0, "no clean run braked while turning");
         assert!(held > 0, "no clean run held a speed cap");
+    }
+
+    #[test]
+    fn a_warm_start_braking_below_the_plans_range_while_turning_keeps_its_side_and_its_path() {
+        // The same 1472-ups start, played turning left 12 frames at `cos theta = -0.97` (below
+        // `c_min`, as a plan's frame can land after the game's quantised angles), then 8 at maximum
+        // acceleration. With its sides cancelled there, the warm start ran units off the run.
+        let g = generate(11, 12, &GeneratorSettings::ci_sized()).unwrap_or_else(|e| panic!("{e}"));
+        let scene = g.scene;
+        let (sim, bound, base) = planning_inputs(&scene);
+        let settings = SearchSettings::for_quality(crate::optimise::Quality::Fast);
+        let planner = Planner::new(
+            &scene,
+            &sim,
+            &settings,
+            &bound,
+            base.seed(),
+            Budget::unlimited(),
+        );
+        let fl = planner.fl;
+        let braking_cos = -0.97;
+        let mut speed = scene.start.vel.length();
+        let mut planned = Vec::new();
+        for k in 0..20 {
+            let u = if k < 12 {
+                FrameControl {
+                    sigma: 1.0,
+                    c: braking_cos * speed,
+                }
+            } else {
+                FrameControl {
+                    sigma: if k % 2 == 0 { 1.0 } else { -1.0 },
+                    c: fl.c_plan_max(speed),
+                }
+            };
+            assert!(k >= 12 || u.c < fl.c_min(speed));
+            planned.push(u);
+            speed = crate::optimise::model::frame(
+                &ModelState {
+                    pos: Vec2::ZERO,
+                    speed,
+                    heading: 0.0,
+                },
+                u,
+                &fl,
+                false,
+            )
+            .0
+            .speed;
+        }
+        let mut player =
+            crate::optimise::verify::PlanPlayer::new(&planner.start, &[], planned, fl, false);
+        let run = sim.run(&mut player);
+        assert!(
+            run.frames.len() >= 20,
+            "the run stopped at {}",
+            run.frames.len()
+        );
+        let warm = planner.warm_start(&run);
+        let states = rollout(&planner.start, &warm[..20], &fl);
+        for (k, (x, rec)) in states.iter().zip(&run.frames).enumerate() {
+            assert_eq!(rec.contacts, 0, "frame {k} touched a wall");
+            assert!(
+                (x.pos - rec.pos).length() < 1e-6,
+                "frame {k}: {x:?} against {rec:?}"
+            );
+        }
+        // The turn is real: a warm start with the braking frames' sides cancelled ends units away.
+        let mut cancelled = warm.clone();
+        cancelled[..12].iter_mut().for_each(|u| u.sigma = 0.0);
+        let off = rollout(&planner.start, &cancelled[..20], &fl);
+        assert!((off[19].pos - run.frames[19].pos).length() > 1.0);
     }
 }
