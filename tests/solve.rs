@@ -295,6 +295,21 @@ fn a_faster_line_found_from_the_plan_is_rounded_too() {
 }
 
 #[test]
+fn the_fastest_greedy_starts_line_of_the_plans_frame_is_rounded_too() {
+    // Generated scene 17 of seed 84 (CI-sized family: 100 fps, air acceleration 10, 1157 ups into one
+    // turn, rule walls 180 units apart): rounded from the relaxed stage's line alone the plan crosses at
+    // 1.254342 s; a greedy start's line of the same frame 126, rounded as well, gives 1.253606 s, 0.013
+    // frame behind the certificate (1.253476 s).
+    let (plan, r) = ci_sized_plan_and_certificate(84, 17);
+    assert_eq!(
+        (plan.frames, r.frames),
+        (126, 126),
+        "{plan:?} against {r:?}"
+    );
+    assert!(plan.time < 1.2540, "{plan:?} against {r:?}");
+}
+
+#[test]
 fn a_rejected_step_whose_wall_rows_are_corrected_keeps_the_descent_going() {
     // Generated scene 10 of seed 11 (CI-sized family: 100 fps, air acceleration 10): without the
     // second-order correction of rejected steps the count search's steps land in the walls (the model's
