@@ -310,6 +310,16 @@ fn the_fastest_greedy_starts_line_of_the_plans_frame_is_rounded_too() {
 }
 
 #[test]
+fn a_plan_that_fails_its_replay_a_frame_ahead_is_polished_again_wider() {
+    // Generated scene 26 of seed 84 (CI-sized family: 250 fps, air acceleration 10, 180 ups into two
+    // turns, solid walls 253 units apart): plans rounded in the certificate's frame 707 are clear of the
+    // walls at every frame's end in the model, but played they touch a wall and the engine-exact run does
+    // not cross within their frames; the best plan that stayed valid crossed in 708. The earliest planned
+    // of them, polished again at ten times the final margin, crosses in 707.
+    assert_ci_sized_plan_in_its_certificate_frame(84, 26, 707);
+}
+
+#[test]
 fn a_rejected_step_whose_wall_rows_are_corrected_keeps_the_descent_going() {
     // Generated scene 10 of seed 11 (CI-sized family: 100 fps, air acceleration 10): without the
     // second-order correction of rejected steps the count search's steps land in the walls (the model's

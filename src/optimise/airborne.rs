@@ -15,7 +15,7 @@
 use super::baseline::Baseline;
 use super::model::{rollout, FrameControl};
 use super::planner::Planner;
-use super::polish::{rounded_and_polished, MARGIN_RETRIES};
+use super::polish::{polished_again, rounded_and_polished, MARGIN_RETRIES};
 use super::relaxed::{
     count_search, relaxed_plan, Certifier, CountSearch, Descent, Relaxation, StartKind,
 };
@@ -176,6 +176,9 @@ pub(super) fn plan_airborne(
     };
     if let Some(line) = faster_line {
         plans_of_certificate_line(planner, line, terms, progress, &mut best);
+        plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
+    }
+    if failed_plan_polished_wider(planner, greedy_s, &mut best) {
         plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
     }
     AirbornePlan {
@@ -442,23 +445,70 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
             margin_retries,
         );
         for plan in plans {
-            let planned_s = planner.crossing_of(&plan.controls).map(|c| c.time);
+            let planned = planner.crossing_of(&plan.controls);
+            let planned_s = planned.map(|c| c.time);
             let primary = plan.primary;
-            if let Some((t, trace)) = quantised_and_verified(planner, plan.controls) {
-                // A replay that fell half a frame behind its plan scraped a wall the margin did not
-                // keep it off: the next margin is tried as well.
-                let as_planned = planned_s.is_none_or(|p| t <= p + 0.5 * planner.fl.tau_s);
-                valid |= primary && as_planned;
-                let limit = best.as_ref().map_or(greedy_s, |b| b.0);
-                if t < limit {
-                    *best = Some((t, trace));
+            let kept = plan.controls.clone();
+            let Some((t, trace)) = quantised_and_verified(planner, plan.controls) else {
+                let earliest = &mut planner.earliest_failed_plan;
+                if let Some(p) =
+                    planned.filter(|p| earliest.as_ref().is_none_or(|f| p.time < f.0.time))
+                {
+                    *earliest = Some((p, kept));
                 }
+                continue;
+            };
+            // A replay that fell half a frame behind its plan scraped a wall the margin did not keep it
+            // off: the next margin is tried as well.
+            let as_planned = planned_s.is_none_or(|p| t <= p + 0.5 * planner.fl.tau_s);
+            valid |= primary && as_planned;
+            let limit = best.as_ref().map_or(greedy_s, |b| b.0);
+            if t < limit {
+                *best = Some((t, trace));
             }
         }
         if valid || planner.timed_out {
             break;
         }
     }
+}
+
+/// The exact plan planned to cross first of those whose replay failed ([`Planner::earliest_failed_plan`]),
+/// where it was planned a frame or more before the best plan: polished again from its own controls at the
+/// wider final margins until a plan of it stays valid, once a solve. A plan clear of the walls at its
+/// frames' ends fails its replay where the move between two of them cuts a grown wall's corner (the model
+/// holds the ends only) or where, touching a wall, the engine-exact run falls behind the frames its controls
+/// give; a wider margin keeps it off the walls for a little time. A plan planned in the best plan's own
+/// frame is left: on long runs the polishes cost more than the rounding for a fraction of a frame at most.
+fn failed_plan_polished_wider(planner: &mut Planner, greedy_s: f64, best: &mut BestPlan) -> bool {
+    let Some((planned, controls)) = planner.earliest_failed_plan.take() else {
+        return false;
+    };
+    let before_s = best.as_ref().map(|b| b.0);
+    let final_margin_units = planner.settings.margin_units;
+    for factor in &FINAL_MARGIN_FACTORS[1..] {
+        let best_frame = best.as_ref().map_or(Some(u64::MAX), |(_, trace)| {
+            trace.crossing.map(|c| c.frames)
+        });
+        let ahead = best_frame.is_some_and(|f| planned.frames < f) && planned.time < greedy_s;
+        if planner.timed_out || !ahead {
+            break;
+        }
+        let mut valid = false;
+        for plan in polished_again(planner, controls.clone(), factor * final_margin_units) {
+            if let Some((t, trace)) = quantised_and_verified(planner, plan) {
+                valid = true;
+                if t < best.as_ref().map_or(greedy_s, |b| b.0) {
+                    *best = Some((t, trace));
+                }
+            }
+        }
+        if valid {
+            break;
+        }
+    }
+    best.as_ref()
+        .is_some_and(|b| before_s.is_none_or(|t| b.0 < t))
 }
 
 #[cfg(test)]

@@ -33,6 +33,9 @@ pub(super) struct Planner<'a> {
     pub(super) timed_out: bool,
     /// The first stage the budget cut.
     pub(super) cut_in: Option<Stage>,
+    /// Of the exact plans whose replay failed, the one planned to cross first: where it crosses in the
+    /// model, and its controls.
+    pub(super) earliest_failed_plan: Option<(Crossing, Vec<FrameControl>)>,
 }
 
 /// The airborne frame law of a scene.
@@ -81,6 +84,7 @@ impl<'a> Planner<'a> {
             stats: SearchStats::default(),
             timed_out: false,
             cut_in: None,
+            earliest_failed_plan: None,
         }
     }
 
@@ -99,6 +103,7 @@ impl<'a> Planner<'a> {
             stats: SearchStats::default(),
             timed_out: false,
             cut_in: None,
+            earliest_failed_plan: None,
         }
     }
 

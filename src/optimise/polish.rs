@@ -224,6 +224,17 @@ fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Pol
     Polished { plans, added }
 }
 
+/// An exact plan's controls polished again at `margin` from where they are ([`polished`]): every plan that
+/// comes of it, the deciding ones and the added one alike.
+pub(super) fn polished_again(
+    planner: &mut Planner,
+    exact: Vec<FrameControl>,
+    margin: f64,
+) -> Vec<Vec<FrameControl>> {
+    let Polished { plans, added } = polished_if_set(planner, exact, margin);
+    plans.into_iter().chain(added).collect()
+}
+
 /// `controls` with every frame's `c` out of the anglemod guard's band ([`FrameLaw::under_the_guard`]),
 /// at the speeds of its own trajectory.
 fn under_the_guard(
