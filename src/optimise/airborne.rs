@@ -427,7 +427,8 @@ fn exact_plans_of_both_lines(
 /// Stages 3 and 4 for one relaxed line: rounded, polished, quantised and verified, first at the settings'
 /// final margin; if no plan rounded at the first horizon stays valid (a tight margin along a long wall),
 /// again as the line's [`Widening`] allows. A plan replaces `best` when it is faster (and faster than
-/// `greedy_s`).
+/// `greedy_s`); a plan whose replay fails is kept aside if it was planned to cross before every other
+/// such plan ([`Planner::earliest_failed_plan`], for [`failed_plan_polished_wider`]).
 fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut BestPlan) {
     let final_margin_units = planner.settings.margin_units;
     let (factors, margin_retries) = match source.widening {
