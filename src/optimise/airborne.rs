@@ -463,10 +463,7 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
             // off: the next margin is tried as well.
             let as_planned = planned_s.is_none_or(|p| t <= p + 0.5 * planner.fl.tau_s);
             valid |= primary && as_planned;
-            let limit = best.as_ref().map_or(greedy_s, |b| b.0);
-            if t < limit {
-                *best = Some((t, trace));
-            }
+            kept_if_faster(best, greedy_s, t, trace);
         }
         if valid || planner.timed_out {
             break;
@@ -485,31 +482,40 @@ fn failed_plan_polished_wider(planner: &mut Planner, greedy_s: f64, best: &mut B
     let Some((planned, controls)) = planner.earliest_failed_plan.take() else {
         return false;
     };
-    let before_s = best.as_ref().map(|b| b.0);
+    let ahead = best.as_ref().map_or(planned.time < greedy_s, |(_, trace)| {
+        trace.crossing.is_some_and(|c| planned.frames < c.frames)
+    });
+    if !ahead {
+        return false;
+    }
     let final_margin_units = planner.settings.margin_units;
+    let mut improved = false;
     for factor in &FINAL_MARGIN_FACTORS[1..] {
-        let best_frame = best.as_ref().map_or(Some(u64::MAX), |(_, trace)| {
-            trace.crossing.map(|c| c.frames)
-        });
-        let ahead = best_frame.is_some_and(|f| planned.frames < f) && planned.time < greedy_s;
-        if planner.timed_out || !ahead {
+        if planner.timed_out {
             break;
         }
         let mut valid = false;
         for plan in polished_again(planner, controls.clone(), factor * final_margin_units) {
             if let Some((t, trace)) = quantised_and_verified(planner, plan) {
                 valid = true;
-                if t < best.as_ref().map_or(greedy_s, |b| b.0) {
-                    *best = Some((t, trace));
-                }
+                improved |= kept_if_faster(best, greedy_s, t, trace);
             }
         }
         if valid {
             break;
         }
     }
-    best.as_ref()
-        .is_some_and(|b| before_s.is_none_or(|t| b.0 < t))
+    improved
+}
+
+/// The plan `(t, trace)` made the best if it is faster than the best so far and than `greedy_s`
+/// (seconds); whether it was.
+fn kept_if_faster(best: &mut BestPlan, greedy_s: f64, t: f64, trace: Trace) -> bool {
+    let faster = t < best.as_ref().map_or(greedy_s, |b| b.0);
+    if faster {
+        *best = Some((t, trace));
+    }
+    faster
 }
 
 #[cfg(test)]

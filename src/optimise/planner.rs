@@ -33,8 +33,9 @@ pub(super) struct Planner<'a> {
     pub(super) timed_out: bool,
     /// The first stage the budget cut.
     pub(super) cut_in: Option<Stage>,
-    /// Of the exact plans whose replay failed, the one planned to cross first: where it crosses in the
-    /// model, and its controls.
+    /// Of the exact plans whose replay failed on this planner, the one planned to cross first: where it
+    /// crosses in the model, and its controls (a fork's own is not joined back: exact plans are verified on
+    /// the solve's planner).
     pub(super) earliest_failed_plan: Option<(Crossing, Vec<FrameControl>)>,
 }
 
@@ -253,7 +254,7 @@ impl<'a> Planner<'a> {
             // the heading by more than its linearisation sees. A frame below the range that turns (a
             // greedy run braking into a corner, a plan's frame after the game's quantised angles) keeps
             // its side: cancelled, its push sideways is lost and the run replays off its path.
-            if u.c < fl.c_min(v) && braking_straight_back(u.c, v, &fl) {
+            if braking_straight_back(u.c, v, &fl) {
                 u.sigma = 0.0;
             }
             warm.push(u);
@@ -264,11 +265,12 @@ impl<'a> Planner<'a> {
 }
 
 /// Whether a frame of strafe cosine `c / v` (speed `v`, ups) pushes straight back to within one step of
-/// the replay's strafe angle: `sin theta < q`, `q` = [`super::model::AngleControl::step_rad`]
+/// the replay's strafe angle: `c < 0` and `sin theta < q`, `q` = [`super::model::AngleControl::step_rad`]
 /// (docs/physics.md section 1), so that its side moves the player by less than the game can resolve.
+/// Such a frame is below [`FrameLaw::c_min`].
 fn braking_straight_back(c: f64, v: f64, fl: &FrameLaw) -> bool {
     let step = v * fl.angle_control.step_rad();
-    v * v - c * c < step * step
+    c < 0.0 && v * v - c * c < step * step
 }
 
 /// The finish line's unit normal pointing the way the shortest path crosses it.
