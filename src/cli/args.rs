@@ -86,14 +86,19 @@ pub struct ArtifactFlags {
     pub hltas: Option<PathBuf>,
 }
 
-/// Accuracy levels of `solve`, cheapest first.
+/// Accuracy levels of `solve`, cheapest first. At every level the plan is checked in f64 and in the
+/// engine-exact mode; on airborne scenes every level solves the relaxed problem, rounds it to the game's
+/// sides and polishes the plan, and the levels differ in iterations, tolerances, wall margin and
+/// certificate starts (`SearchSettings::for_quality`); on scenes with jumps, in the grids searched.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum QualityArg {
-    /// Coarse: few iterations, the relaxed problem only.
+    /// The fewest iterations and a coarse tolerance.
     Fast,
-    /// The default: relaxed, then exact sides.
+    /// The default: more iterations and certificate starts, a fine tolerance; on airborne scenes runs
+    /// `fast` first and keeps the faster plan.
     Balanced,
-    /// Exact sides polished to convergence, checked in engine-exact mode.
+    /// The most iterations, tight tolerances, half the wall margin (0.01 units); on airborne scenes runs
+    /// `fast` and `balanced` first.
     Exact,
 }
 
@@ -102,7 +107,8 @@ pub enum QualityArg {
 pub struct SolveArgs {
     /// The scene file (TOML).
     pub scene: PathBuf,
-    /// How hard to work.
+    /// How hard to work. At every level the plan is checked in f64 and in the engine-exact mode (an
+    /// airborne plan after its sides are rounded to the game's and it is polished).
     #[arg(long, value_enum, default_value_t = QualityArg::Balanced)]
     pub quality: QualityArg,
     /// Stop after this many seconds (every stage, writing included) with the best valid plan so far.
