@@ -719,7 +719,7 @@ pub(super) fn model_crossing(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimise::planner::{planning_inputs, Planner};
+    use crate::optimise::planner::{planning_inputs, staircase_scene, Planner};
     use crate::optimise::Quality;
     use crate::scene::generate::{generate, GeneratorSettings};
 
@@ -754,6 +754,60 @@ mod tests {
             furthest = furthest.max((Vec2::new(dx[0], dx[1]) - step.dp[k]).length());
         }
         assert!(furthest < 1e-9, "{furthest} units apart");
+    }
+
+    #[test]
+    fn a_move_cutting_a_grown_corner_between_two_clear_frame_ends_is_a_violation() {
+        // The merit holds each frame's whole move, not only its end: next to every corner of a grown
+        // wall that stands out into the corridor, a move from just outside one face to just outside the
+        // other has both ends clear and its middle inside.
+        let scene = staircase_scene(2);
+        let (sim, bound, base) = planning_inputs(&scene);
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let planner = Planner::new(
+            &scene,
+            &sim,
+            &settings,
+            &bound,
+            &base.clean[0].trace,
+            Budget::unlimited(),
+        );
+        let corridor = sim.corridor();
+        let accepted = MERIT_MARGIN_SHARE * settings.margin_units;
+        let (outside, across) = (4.0 * accepted, 1.0);
+        let h = crate::geometry::HULL_HALF_WIDTH_UNITS;
+        let mut cut_corners = 0;
+        for vertex in corridor.walls().iter().flat_map(|w| &w.points) {
+            for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+                let corner = *vertex + Vec2::new(sx * h, sy * h);
+                let p0 = corner + Vec2::new(sx * outside, -sy * across);
+                let p1 = corner + Vec2::new(-sx * across, sy * outside);
+                let ends_clear =
+                    corridor.clearance(p0).min(corridor.clearance(p1)) > 2.0 * accepted;
+                if !ends_clear || corridor.move_clearance(p0, p1, across) >= 0.0 {
+                    continue;
+                }
+                cut_corners += 1;
+                let problem = ScpProblem {
+                    start: ModelState {
+                        pos: p0,
+                        speed: 300.0,
+                        heading: 0.0,
+                    },
+                    ..planner.problem(settings.margin_units, true, 1)
+                };
+                let moved = [ModelState {
+                    pos: p1,
+                    ..problem.start
+                }];
+                let violation = problem.violation(&moved);
+                assert!(
+                    violation > accepted,
+                    "{violation} units across the corner at {corner:?}"
+                );
+            }
+        }
+        assert!(cut_corners >= 2, "{cut_corners} corners cut");
     }
 
     #[test]
