@@ -312,10 +312,10 @@ fn the_fastest_greedy_starts_line_of_the_plans_frame_is_rounded_too() {
 #[test]
 fn a_plan_that_fails_its_replay_a_frame_ahead_is_polished_again_wider() {
     // Generated scene 26 of seed 84 (CI-sized family: 250 fps, air acceleration 10, 180 ups into two
-    // turns, solid walls 253 units apart): plans rounded in the certificate's frame 707 are clear of the
-    // walls at every frame's end in the model, but played they touch a wall and the engine-exact run does
-    // not cross within their frames; the best plan that stayed valid crossed in 708. The earliest planned
-    // of them, polished again at ten times the final margin, crosses in 707.
+    // turns, solid walls 253 units apart): plans rounded in the certificate's frame 707 keep every move
+    // clear of the walls in the model, but played they fall behind, touch a wall and the engine-exact run
+    // does not cross within their frames; of the plans that stay valid the best crosses in 708. The
+    // earliest planned of them, polished again at ten times the final margin, crosses in 707.
     assert_ci_sized_plan_in_its_certificate_frame(84, 26, 707);
 }
 

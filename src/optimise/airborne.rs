@@ -473,10 +473,10 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
 
 /// The exact plan planned to cross first of those whose replay failed ([`Planner::earliest_failed_plan`]),
 /// where it was planned a frame or more before the best plan: polished again from its own controls at the
-/// wider final margins until a plan of it stays valid, once a solve. A plan clear of the walls at its
-/// frames' ends fails its replay where the move between two of them cuts a grown wall's corner (the model
-/// holds the ends only) or where, touching a wall, the engine-exact run falls behind the frames its controls
-/// give; a wider margin keeps it off the walls for a little time. A plan planned in the best plan's own
+/// wider final margins until a plan of it stays valid, once a solve. A plan whose every move keeps the
+/// margin in the model fails its replay where the replay, on the game's quantised angles, falls behind it
+/// by more than that: its move cuts a grown wall's corner, or it touches a wall and the engine-exact run
+/// falls behind the frames its controls give; a wider margin leaves room for that lag. A plan planned in the best plan's own
 /// frame is left: on long runs the polishes cost more than the rounding for a fraction of a frame at most.
 fn failed_plan_polished_wider(planner: &mut Planner, greedy_s: f64, best: &mut BestPlan) -> bool {
     let Some((planned, controls)) = planner.earliest_failed_plan.take() else {
