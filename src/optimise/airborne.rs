@@ -1,4 +1,4 @@
-//! The airborne solve, stages 2 to 4 of [`super::search`] in order:
+//! The airborne solve, stages 2 to 4 of [`super::search`], in this order:
 //!
 //! 1. the relaxed line ([`super::relaxed`]) at the planning margin, which leaves room for the zigzag of
 //!    rounded sides; the count search over it is the search's globalisation;
@@ -7,7 +7,8 @@
 //! 3. the same line refined at the tight margin, where the zigzag of real sides is counted at what it is
 //!    rather than at the most a braking frame could swing;
 //! 4. each line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
-//!    fastest valid exact plan is kept.
+//!    fastest valid exact plan is kept;
+//! 5. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]).
 //!
 //! Where the relaxed stage finds no line from the seed, the certificate's greedy starts' lines are the
 //! ones rounded.
@@ -19,6 +20,7 @@ use super::polish::{polished_again, rounded_and_polished, MARGIN_RETRIES};
 use super::relaxed::{
     count_search, relaxed_plan, Certifier, CountSearch, Descent, Relaxation, StartKind,
 };
+use super::scp::StageKind;
 use super::search::Progress;
 use super::verify::quantised_and_verified;
 use crate::sim::Trace;
@@ -179,6 +181,9 @@ pub(super) fn plan_airborne(
         plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
     }
     if failed_plan_polished_wider(planner, greedy_s, &mut best) {
+        plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
+    }
+    if best_plan_polished_on(planner, greedy_s, &mut best) {
         plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
     }
     AirbornePlan {
@@ -495,13 +500,45 @@ fn failed_plan_polished_wider(planner: &mut Planner, greedy_s: f64, best: &mut B
             break;
         }
         let mut valid = false;
-        for plan in polished_again(planner, controls.clone(), factor * final_margin_units) {
+        let margin = factor * final_margin_units;
+        for plan in polished_again(planner, controls.clone(), margin, StageKind::Plain) {
             if let Some((t, trace)) = quantised_and_verified(planner, plan) {
                 valid = true;
                 improved |= kept_if_faster(best, greedy_s, t, trace);
             }
         }
         if valid {
+            break;
+        }
+    }
+    improved
+}
+
+/// The fastest valid plan polished again from its own controls as played, at the final margin, in
+/// stages whose trust region regrows after a kept second-order correction ([`StageKind::Regrowing`]),
+/// while a round makes it faster (at most the settings' `final_polish_rounds`): each plan quantised and
+/// verified, and kept only if faster, so the plan can only gain. The polishes before it grow their
+/// trust region after good steps only: along a plan pressed against the walls nearly every step is a
+/// correction, the region stays where the rejections cut it, and the polish stops at its iterations
+/// while the plan is still improving, on some corridors by more than a frame (docs/design.md, "The
+/// final polish"). Whether the plan got faster.
+fn best_plan_polished_on(planner: &mut Planner, greedy_s: f64, best: &mut BestPlan) -> bool {
+    let margin = planner.settings.margin_units;
+    let mut improved = false;
+    for _ in 0..planner.settings.final_polish_rounds {
+        let Some((_, trace)) = best.as_ref().filter(|_| !planner.timed_out) else {
+            break;
+        };
+        let controls = planner.warm_start(trace);
+        let mut faster = false;
+
+        for plan in polished_again(planner, controls, margin, StageKind::Regrowing) {
+            if let Some((t, trace)) = quantised_and_verified(planner, plan) {
+                faster |= kept_if_faster(best, greedy_s, t, trace);
+            }
+        }
+        improved |= faster;
+        if !faster {
             break;
         }
     }

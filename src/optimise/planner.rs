@@ -2,7 +2,7 @@
 //! direction of progress, the settings, the deadline and the work done so far.
 
 use super::model::{frame_control_of, rollout, FrameControl, FrameLaw, ModelState};
-use super::scp::{scp_stage, ScpProblem};
+use super::scp::{run_scp, ScpProblem, StageKind};
 use super::search::{SearchSettings, SearchStats};
 use super::LowerBound;
 use crate::budget::{Budget, Stage};
@@ -178,22 +178,31 @@ impl<'a> Planner<'a> {
     }
 
     /// Runs one SCP stage of at most `max_iters` iterations from `controls`, counting its work; returns
-    /// the improved controls and whether it stopped at its iteration cap.
+    /// the improved controls and whether it stopped at its iteration cap (still improving) rather than
+    /// converged.
     pub(super) fn stage(
         &mut self,
         problem: ScpProblem,
         controls: Vec<FrameControl>,
         max_iters: u64,
     ) -> (Vec<FrameControl>, bool) {
-        scp_stage(
-            problem,
-            controls,
-            max_iters,
-            self.settings,
-            self.budget,
-            &mut self.stats,
-            &mut self.timed_out,
-        )
+        self.stage_of(problem, controls, max_iters, StageKind::Plain)
+    }
+
+    /// [`Self::stage`], its trust region growing as `kind` says.
+    pub(super) fn stage_of(
+        &mut self,
+        problem: ScpProblem,
+        controls: Vec<FrameControl>,
+        max_iters: u64,
+        kind: StageKind,
+    ) -> (Vec<FrameControl>, bool) {
+        let tol = self.settings.tol_progress_units;
+        let (c, timed_out, capped, stats) =
+            run_scp(problem, controls, max_iters, tol, self.budget, kind);
+        self.stats.add(&stats);
+        self.timed_out |= timed_out;
+        (c, capped)
     }
 
     /// The time of a planned run of `controls` after the prefix: the fractional crossing time of the

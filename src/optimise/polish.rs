@@ -9,7 +9,7 @@
 use super::model::{frame, rollout, FrameControl, FrameLaw, ModelState};
 use super::planner::Planner;
 use super::rounding::{round_sides, ROUNDING_HORIZONS_S};
-use super::scp::{model_crossing, ScpProblem, CLEAN_VIOLATION_UNITS};
+use super::scp::{model_crossing, ScpProblem, StageKind, CLEAN_VIOLATION_UNITS};
 use crate::budget::Stage;
 
 /// Times the planning line is re-solved with a wider margin when rounding leaves the walls.
@@ -131,11 +131,14 @@ fn polished_side_by_side(
     };
     let others: Vec<_> = roundings
         .map(|(primary, sides)| {
-            move |fork: &mut Planner| (primary, polished_if_set(fork, sides, final_margin))
+            move |fork: &mut Planner| {
+                let polished = polished_if_set(fork, sides, final_margin, StageKind::Plain);
+                (primary, polished)
+            }
         })
         .collect();
     let (first, others) = planner.beside_forks(others, |planner| {
-        polished_if_set(planner, first_sides, final_margin)
+        polished_if_set(planner, first_sides, final_margin, StageKind::Plain)
     });
     std::iter::once((first_primary, first))
         .chain(others)
@@ -158,11 +161,16 @@ fn rounded(
     exact
 }
 
-/// `exact` polished at `final_margin` ([`polished`]), or as it is when the settings polish nothing or the
-/// time is up.
-fn polished_if_set(planner: &mut Planner, exact: Vec<FrameControl>, final_margin: f64) -> Polished {
+/// `exact` polished at `final_margin` in stages of `kind` ([`polished`]), or as it is when the settings
+/// polish nothing or the time is up.
+fn polished_if_set(
+    planner: &mut Planner,
+    exact: Vec<FrameControl>,
+    final_margin: f64,
+    kind: StageKind,
+) -> Polished {
     if planner.settings.polish_iters > 0 && !planner.timed_out {
-        polished(planner, exact, final_margin)
+        polished(planner, exact, final_margin, kind)
     } else {
         Polished::only(exact)
     }
@@ -180,11 +188,16 @@ fn polished_if_set(planner: &mut Planner, exact: Vec<FrameControl>, final_margin
 /// ([`Polished::added`]): in the first case the plan as polished, in the second the one out of the band.
 /// The plans go on to be quantised and replayed, and the fastest valid one is kept; plans that come out
 /// the same are given once.
-fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Polished {
+fn polished(
+    planner: &mut Planner,
+    exact: Vec<FrameControl>,
+    margin: f64,
+    kind: StageKind,
+) -> Polished {
     let iters = planner.settings.polish_iters;
     let pr = planner.problem(margin, false, 1);
     let rounded = exact.clone();
-    let exact = planner.stage(pr, exact, iters).0;
+    let exact = planner.stage_of(pr, exact, iters, kind).0;
     // A rounding inside a wall that the first stage could not move at all (every step rejected) does not
     // move in the second either.
     let stuck = exact == rounded && {
@@ -199,7 +212,7 @@ fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Pol
         anglemod_guard: false,
         ..planner.problem(margin, false, 1)
     };
-    let turned = planner.stage(pr, exact.clone(), iters).0;
+    let turned = planner.stage_of(pr, exact.clone(), iters, kind).0;
     let fl = planner.fl;
     let mut guarded = under_the_guard(&planner.start, &turned, &fl);
     let moved = guarded != turned;
@@ -208,7 +221,7 @@ fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Pol
             turn_less: true,
             ..planner.problem(margin, false, 1)
         };
-        let repaired = planner.stage(pr, guarded, iters).0;
+        let repaired = planner.stage_of(pr, guarded, iters, kind).0;
         guarded = under_the_guard(&planner.start, &repaired, &fl);
     }
     // In the first case every plan keeps under the guard and the plan out of the band is the line's own;
@@ -224,14 +237,15 @@ fn polished(planner: &mut Planner, exact: Vec<FrameControl>, margin: f64) -> Pol
     Polished { plans, added }
 }
 
-/// An exact plan's controls polished again at `margin` from where they are ([`polished`]): every plan that
-/// comes of it, the deciding ones and the added one alike.
+/// An exact plan's controls polished again at `margin` from where they are, in stages of `kind`
+/// ([`polished`]): every plan that comes of it, the deciding ones and the added one alike.
 pub(super) fn polished_again(
     planner: &mut Planner,
     exact: Vec<FrameControl>,
     margin: f64,
+    kind: StageKind,
 ) -> Vec<Vec<FrameControl>> {
-    let Polished { plans, added } = polished_if_set(planner, exact, margin);
+    let Polished { plans, added } = polished_if_set(planner, exact, margin, kind);
     plans.into_iter().chain(added).collect()
 }
 
@@ -420,7 +434,7 @@ mod tests {
         // ends 0.45 units into them).
         on_the_kink_guard_scene(|planner, warm| {
             let (fl, margin) = (planner.fl, planner.settings.margin_units);
-            let polished = polished(planner, warm, margin);
+            let polished = polished(planner, warm, margin, StageKind::Plain);
             // The plan put out of the band and polished again and the first stage's, and apart from them
             // the one as first polished.
             assert_eq!(polished.plans.len(), 2, "no frame turned less");
@@ -452,7 +466,7 @@ mod tests {
             let Some(sides) = rounded(planner, &relaxed, ROUNDING_HORIZONS_S[0]) else {
                 panic!("no rounding")
             };
-            let polished = polished(planner, sides, margin);
+            let polished = polished(planner, sides, margin, StageKind::Plain);
             assert_eq!(polished.plans.len(), 2, "no frame turned less");
             let Some(turned) = &polished.added else {
                 panic!("no frame ended in the band")
@@ -498,7 +512,8 @@ mod tests {
             let expected: Vec<(bool, Polished)> = roundings
                 .iter()
                 .map(|(primary, sides)| {
-                    let plans = polished_if_set(&mut one_by_one, sides.clone(), margin);
+                    let plans =
+                        polished_if_set(&mut one_by_one, sides.clone(), margin, StageKind::Plain);
                     (*primary, plans)
                 })
                 .collect();

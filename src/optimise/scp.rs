@@ -17,7 +17,7 @@
 use super::lagrangian::{convexify, lagrangian_block, CurvatureBlock};
 use super::model::{knot, knot_hessian, rollout_knots, FrameControl, FrameLaw, ModelState};
 use super::qp::{self, SubProblem, SubStepStatus, WallRow};
-use super::search::{SearchSettings, SearchStats};
+use super::search::SearchStats;
 use crate::budget::Budget;
 use crate::geometry::{Corridor, Separation};
 use crate::physics::Vec2;
@@ -325,6 +325,8 @@ pub struct ScpSolver<'c> {
     costs: Vec<f64>,
     /// The stage's iteration cap (the stall test weighs the iterations left).
     max_iters: u64,
+    /// How the trust region grows.
+    kind: StageKind,
 }
 
 impl<'c> ScpSolver<'c> {
@@ -341,6 +343,7 @@ impl<'c> ScpSolver<'c> {
             restored_last: false,
             costs: Vec::new(),
             max_iters: u64::MAX,
+            kind: StageKind::Plain,
         }
     }
 }
@@ -364,6 +367,12 @@ fn stepped(controls: &[FrameControl], du: &[(f64, f64)]) -> Vec<f64> {
         .flat_map(|(u, d)| [(u.sigma + d.0).clamp(-1.0, 1.0), u.c + d.1])
         .collect()
 }
+
+/// The largest trust radius.
+const MAX_TRUST: f64 = 4.0;
+
+/// A step that delivers more than this share of its predicted gain doubles the trust radius.
+const GOOD_STEP_RATIO: f64 = 0.75;
 
 /// A step's change of each frame's side at trust radius 1.
 const SIGMA_TRUST: f64 = 0.1;
@@ -493,8 +502,8 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         if accepted {
             self.curvature_share = next_curvature_share(self.curvature_share, Some(ratio));
             self.restored_last = false;
-            if ratio > 0.75 {
-                self.trust = (self.trust * 2.0).min(4.0);
+            if ratio > GOOD_STEP_RATIO {
+                self.trust = (self.trust * 2.0).min(MAX_TRUST);
             } else if ratio < 0.25 {
                 self.trust *= 0.5;
             }
@@ -508,9 +517,12 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
                 &step.dp,
                 seconds_left,
             )? {
-                // Delivered enough of the first step's prediction: kept, the trust region as it was.
-                if cost - corrected_cost >= ACCEPT_RATIO * step.predicted {
+                // Delivered enough of the first step's prediction: kept, the trust region as the
+                // stage's kind says.
+                let delivered = (cost - corrected_cost) / step.predicted;
+                if delivered >= ACCEPT_RATIO {
                     self.stats.corrected_steps += 1;
+                    self.trust = trust_after_correction(self.trust, delivered, self.kind);
                     return Ok((state.param(corrected).cost(corrected_cost), None));
                 }
             }
@@ -632,6 +644,27 @@ impl ScpSolver<'_> {
     }
 }
 
+/// How an SCP stage grows its trust region.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum StageKind {
+    /// After a good step only; a kept second-order correction leaves the region as it was.
+    Plain,
+    /// After a kept second-order correction that delivers most of the step's prediction too. Along a
+    /// line pressed against the walls nearly every step is corrected, and with the region left as it was
+    /// it stays where the rejections cut it, and the stage creeps (docs/design.md, "The final polish").
+    Regrowing,
+}
+
+/// The trust radius after a kept second-order correction that delivered `delivered` times the first
+/// step's predicted gain: in a [`StageKind::Regrowing`] stage doubled (up to [`MAX_TRUST`]) where that
+/// is more than [`GOOD_STEP_RATIO`], as after a good step; else `trust` as it was.
+fn trust_after_correction(trust: f64, delivered: f64, kind: StageKind) -> f64 {
+    match kind {
+        StageKind::Regrowing if delivered > GOOD_STEP_RATIO => (2.0 * trust).min(MAX_TRUST),
+        _ => trust,
+    }
+}
+
 /// Runs SCP on `controls`; returns the improved controls, whether the time limit stopped it, whether it
 /// stopped at the iteration cap, and the work done.
 pub(super) fn run_scp(
@@ -640,10 +673,12 @@ pub(super) fn run_scp(
     max_iters: u64,
     tol: f64,
     budget: Budget,
+    kind: StageKind,
 ) -> (Vec<FrameControl>, bool, bool, SearchStats) {
     let x0 = pack(&controls);
     let mut solver = ScpSolver::new(tol, budget);
     solver.max_iters = max_iters;
+    solver.kind = kind;
     let mut exec =
         Executor::new(problem, solver).configure(|s| s.param(x0.clone()).max_iters(max_iters));
     if let Some(d) = budget.deadline() {
@@ -677,29 +712,6 @@ pub(super) fn run_scp(
     }
 }
 
-/// One SCP stage: runs it, adds its work to `stats`, notes a timeout; returns the improved controls and
-/// whether the stage stopped at its iteration cap (still improving) rather than converged.
-pub(super) fn scp_stage(
-    problem: ScpProblem,
-    controls: Vec<FrameControl>,
-    max_iters: u64,
-    settings: &SearchSettings,
-    budget: Budget,
-    stats: &mut SearchStats,
-    timed_out: &mut bool,
-) -> (Vec<FrameControl>, bool) {
-    let (c, t, capped, s) = run_scp(
-        problem,
-        controls,
-        max_iters,
-        settings.tol_progress_units,
-        budget,
-    );
-    stats.add(&s);
-    *timed_out |= t;
-    (c, capped)
-}
-
 /// The first frame (1-based) whose move crosses the finish line, in the model.
 pub(super) fn model_crossing(
     start: &ModelState,
@@ -720,6 +732,7 @@ pub(super) fn model_crossing(
 mod tests {
     use super::*;
     use crate::optimise::planner::{planning_inputs, staircase_scene, Planner};
+    use crate::optimise::search::SearchSettings;
     use crate::optimise::Quality;
     use crate::scene::generate::{generate, GeneratorSettings};
 
@@ -832,6 +845,19 @@ mod tests {
         assert_eq!(next_curvature_share(0.25, Some(0.5)), 0.5);
         assert_eq!(next_curvature_share(0.25, None), 0.5);
         assert_eq!(next_curvature_share(1.0, None), 1.0);
+    }
+
+    #[test]
+    fn only_a_regrowing_stage_grows_its_trust_region_after_a_good_correction() {
+        // A correction that delivered most of its prediction: doubled, up to the cap.
+        assert_eq!(trust_after_correction(0.3, 0.9, StageKind::Regrowing), 0.6);
+        assert_eq!(
+            trust_after_correction(3.0, 0.9, StageKind::Regrowing),
+            MAX_TRUST
+        );
+        // One that delivered less, or any in a plain stage: the region as it was.
+        assert_eq!(trust_after_correction(0.3, 0.5, StageKind::Regrowing), 0.3);
+        assert_eq!(trust_after_correction(0.3, 0.9, StageKind::Plain), 0.3);
     }
 
     fn solver_with(costs: &[f64], max_iters: u64) -> ScpSolver<'static> {

@@ -8,8 +8,8 @@
 //! 3. Rounding and polish ([`super::rounding`], [`super::polish`]): the sides rounded to `+-1`, then `c`
 //!    polished with the sides fixed at the final wall margin.
 //! 4. Quantise and verify ([`super::verify`]): yaws on anglemod steps, the plan re-simulated in f64 and in
-//!    the engine-exact mode; the fastest valid plan is kept, and greedy stays the answer when it is
-//!    faster.
+//!    the engine-exact mode; the fastest valid plan is kept, polished on while it gets faster (airborne
+//!    scenes), and greedy stays the answer when it is faster.
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
@@ -51,6 +51,9 @@ pub struct SearchSettings {
     pub relaxed_iters: u64,
     /// SCP iterations of the polishing stage.
     pub polish_iters: u64,
+    /// Times, at most, the fastest airborne plan is polished again from its own controls while it gets
+    /// faster (0: never), each time in stages whose trust region regrows after a corrected step.
+    pub final_polish_rounds: usize,
     /// Stop when the predicted improvement is below this, units of progress.
     pub tol_progress_units: f64,
     /// Weight of a unit of wall violation against a unit of progress.
@@ -74,6 +77,7 @@ impl SearchSettings {
             margin_units: 0.02,
             relaxed_iters: 120,
             polish_iters: 40,
+            final_polish_rounds: 3,
             tol_progress_units: 1e-6,
             slack_weight: 100.0,
             wall_radius_units: 40.0,
