@@ -25,6 +25,11 @@ use super::search::Progress;
 use super::verify::quantised_and_verified;
 use crate::sim::Trace;
 
+/// Least gain of a round of the final polish, in frames, for another round to follow
+/// ([`best_plan_polished_on`]): a round over a few thousand frames costs seconds (docs/design.md, "The
+/// final polish").
+const FINAL_POLISH_MIN_GAIN_FRAMES: f64 = 0.01;
+
 /// Final wall margins tried, as multiples of the setting, until a plan stays valid.
 const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
 
@@ -516,29 +521,29 @@ fn failed_plan_polished_wider(planner: &mut Planner, greedy_s: f64, best: &mut B
 
 /// The fastest valid plan polished again from its own controls as played, at the final margin, in
 /// stages whose trust region regrows after a kept second-order correction ([`StageKind::Regrowing`]),
-/// while a round makes it faster (at most the settings' `final_polish_rounds`): each plan quantised and
-/// verified, and kept only if faster, so the plan can only gain. The polishes before it grow their
-/// trust region after good steps only: along a plan pressed against the walls nearly every step is a
-/// correction, the region stays where the rejections cut it, and the polish stops at its iterations
-/// while the plan is still improving, on some corridors by more than a frame (docs/design.md, "The
-/// final polish"). Whether the plan got faster.
+/// while a round makes it faster by [`FINAL_POLISH_MIN_GAIN_FRAMES`] or more (at most the settings'
+/// `final_polish_rounds` rounds): each plan quantised and verified, and kept only if faster, so the plan
+/// can only gain. The polishes before it grow their trust region after good steps only: along a plan
+/// pressed against the walls nearly every step is a correction, the region stays where the rejections
+/// cut it, and the polish stops at its iterations while the plan is still improving, on some corridors
+/// by more than a frame (docs/design.md, "The final polish"). Whether the plan got faster.
 fn best_plan_polished_on(planner: &mut Planner, greedy_s: f64, best: &mut BestPlan) -> bool {
     let margin = planner.settings.margin_units;
+    let worth_a_round_s = FINAL_POLISH_MIN_GAIN_FRAMES * planner.fl.tau_s;
     let mut improved = false;
     for _ in 0..planner.settings.final_polish_rounds {
-        let Some((_, trace)) = best.as_ref().filter(|_| !planner.timed_out) else {
+        let Some((before_s, trace)) = best.as_ref().filter(|_| !planner.timed_out) else {
             break;
         };
+        let before_s = *before_s;
         let controls = planner.warm_start(trace);
-        let mut faster = false;
-
         for plan in polished_again(planner, controls, margin, StageKind::Regrowing) {
             if let Some((t, trace)) = quantised_and_verified(planner, plan) {
-                faster |= kept_if_faster(best, greedy_s, t, trace);
+                improved |= kept_if_faster(best, greedy_s, t, trace);
             }
         }
-        improved |= faster;
-        if !faster {
+        let gained_s = best.as_ref().map_or(0.0, |b| before_s - b.0);
+        if gained_s < worth_a_round_s {
             break;
         }
     }
