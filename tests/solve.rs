@@ -14,7 +14,12 @@ use strafeopt::sim::Crossing;
 /// the speeds of exact plans, so its optimum lies between the lower bound and the plan (the plan was
 /// rounded from the first start's relaxed line).
 fn solved(scene: &Scene, quality: Quality) -> (Outcome, Crossing) {
-    let o = solve(scene, &SearchSettings::for_quality(quality)).unwrap_or_else(|e| panic!("{e}"));
+    solved_with(scene, &SearchSettings::for_quality(quality))
+}
+
+/// [`solved`] with `settings`.
+fn solved_with(scene: &Scene, settings: &SearchSettings) -> (Outcome, Crossing) {
+    let o = solve(scene, settings).unwrap_or_else(|e| panic!("{e}"));
     let plan = o.trace.crossing.unwrap_or_else(|| panic!("no crossing"));
     if scene.effects.is_air_only() && o.source == "optimised" {
         let r = o
@@ -165,14 +170,15 @@ fn the_final_polish_makes_a_plan_still_improving_faster() {
         final_polish_rounds: 0,
         ..fast
     };
+    // `solved_with` also holds the certificate no slower than the plan the final polish made faster.
     let plan_of = |settings: &SearchSettings| {
-        let o = solve(&scene, settings).unwrap_or_else(|e| panic!("{e}"));
+        let (o, plan) = solved_with(&scene, settings);
         assert!(
             o.trace.feasible() && o.engine_exact.feasible(),
             "{}",
             o.source
         );
-        o.trace.crossing.unwrap_or_else(|| panic!("no crossing"))
+        plan
     };
     let before = plan_of(&without);
     let after = plan_of(&fast);
@@ -413,12 +419,7 @@ fn the_plan_solved_as_a_start_beside_another_optimum_keeps_the_certificate_ahead
     // relaxed stage's, 0.19 ms behind the plan; its line is rounded while the plan, solved as the
     // certificate's start on a fork beside it, reaches a line 0.75 ms ahead of the plan. `solved`
     // asserts that the certificate is not behind the plan: it would be if the fork's start were lost.
-    let g = strafeopt::scene::generate::generate(
-        9301,
-        0,
-        &strafeopt::scene::generate::GeneratorSettings::default(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let g = generate(9301, 0, &GeneratorSettings::default()).unwrap_or_else(|e| panic!("{e}"));
     let (o, plan) = solved(&g.scene, Quality::Fast);
     assert!(o.trace.feasible() && o.engine_exact.feasible());
     let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
@@ -446,9 +447,8 @@ fn ci_sized_plan_and_certificate(
     seed: u64,
     index: u64,
 ) -> (Crossing, strafeopt::optimise::RelaxedCertificate) {
-    let settings = strafeopt::scene::generate::GeneratorSettings::ci_sized();
-    let g = strafeopt::scene::generate::generate(seed, index, &settings)
-        .unwrap_or_else(|e| panic!("{e}"));
+    let settings = GeneratorSettings::ci_sized();
+    let g = generate(seed, index, &settings).unwrap_or_else(|e| panic!("{e}"));
     let (o, plan) = solved(&g.scene, Quality::Fast);
     assert!(o.trace.feasible() && o.engine_exact.feasible());
     let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));

@@ -504,14 +504,11 @@ fn failed_plan_polished_wider(planner: &mut Planner, greedy_s: f64, best: &mut B
         if planner.timed_out {
             break;
         }
-        let mut valid = false;
         let margin = factor * final_margin_units;
-        for plan in polished_again(planner, controls.clone(), margin, StageKind::Plain) {
-            if let Some((t, trace)) = quantised_and_verified(planner, plan) {
-                valid = true;
-                improved |= kept_if_faster(best, greedy_s, t, trace);
-            }
-        }
+        let kind = StageKind::Plain;
+        let (valid, faster) =
+            plans_polished_again(planner, controls.clone(), margin, kind, greedy_s, best);
+        improved |= faster;
         if valid {
             break;
         }
@@ -537,17 +534,35 @@ fn best_plan_polished_on(planner: &mut Planner, greedy_s: f64, best: &mut BestPl
         };
         let before_s = *before_s;
         let controls = planner.warm_start(trace);
-        for plan in polished_again(planner, controls, margin, StageKind::Regrowing) {
-            if let Some((t, trace)) = quantised_and_verified(planner, plan) {
-                improved |= kept_if_faster(best, greedy_s, t, trace);
-            }
-        }
+        let kind = StageKind::Regrowing;
+        improved |= plans_polished_again(planner, controls, margin, kind, greedy_s, best).1;
         let gained_s = best.as_ref().map_or(0.0, |b| before_s - b.0);
         if gained_s < worth_a_round_s {
             break;
         }
     }
     improved
+}
+
+/// The plans of `controls` polished again at `margin` in stages of `kind` ([`polished_again`]), each
+/// quantised and verified and made the best where it is faster ([`kept_if_faster`]): whether any stayed
+/// valid, and whether one was faster.
+fn plans_polished_again(
+    planner: &mut Planner,
+    controls: Vec<FrameControl>,
+    margin: f64,
+    kind: StageKind,
+    greedy_s: f64,
+    best: &mut BestPlan,
+) -> (bool, bool) {
+    let (mut valid, mut faster) = (false, false);
+    for plan in polished_again(planner, controls, margin, kind) {
+        if let Some((t, trace)) = quantised_and_verified(planner, plan) {
+            valid = true;
+            faster |= kept_if_faster(best, greedy_s, t, trace);
+        }
+    }
+    (valid, faster)
 }
 
 /// The plan `(t, trace)` made the best if it is faster than the best so far and than `greedy_s`

@@ -374,6 +374,14 @@ const MAX_TRUST: f64 = 4.0;
 /// A step that delivers more than this share of its predicted gain doubles the trust radius.
 const GOOD_STEP_RATIO: f64 = 0.75;
 
+/// An accepted step that delivers less than this share of its predicted gain halves the trust radius.
+const POOR_STEP_RATIO: f64 = 0.25;
+
+/// The trust radius after a good step: doubled, up to [`MAX_TRUST`].
+fn doubled(trust: f64) -> f64 {
+    (2.0 * trust).min(MAX_TRUST)
+}
+
 /// A step's change of each frame's side at trust radius 1.
 const SIGMA_TRUST: f64 = 0.1;
 
@@ -503,8 +511,8 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
             self.curvature_share = next_curvature_share(self.curvature_share, Some(ratio));
             self.restored_last = false;
             if ratio > GOOD_STEP_RATIO {
-                self.trust = (self.trust * 2.0).min(MAX_TRUST);
-            } else if ratio < 0.25 {
+                self.trust = doubled(self.trust);
+            } else if ratio < POOR_STEP_RATIO {
                 self.trust *= 0.5;
             }
             Ok((state.param(candidate).cost(new_cost), None))
@@ -660,7 +668,7 @@ pub(super) enum StageKind {
 /// is more than [`GOOD_STEP_RATIO`], as after a good step; else `trust` as it was.
 fn trust_after_correction(trust: f64, delivered: f64, kind: StageKind) -> f64 {
     match kind {
-        StageKind::Regrowing if delivered > GOOD_STEP_RATIO => (2.0 * trust).min(MAX_TRUST),
+        StageKind::Regrowing if delivered > GOOD_STEP_RATIO => doubled(trust),
         _ => trust,
     }
 }
