@@ -4,7 +4,9 @@
 
 use std::path::Path;
 use std::time::Duration;
-use strafeopt::optimise::{solve, Outcome, Quality, SearchSettings, SearchStatus};
+use strafeopt::optimise::{
+    solve, solve_with_progress, Outcome, Progress, Quality, SearchSettings, SearchStatus,
+};
 use strafeopt::scene::generate::{generate, GeneratorSettings};
 use strafeopt::scene::Scene;
 use strafeopt::sim::Crossing;
@@ -453,4 +455,43 @@ fn ci_sized_plan_and_certificate(
     assert!(o.trace.feasible() && o.engine_exact.feasible());
     let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
     (plan, r)
+}
+
+#[test]
+fn a_seed_that_never_reaches_the_line_is_planned_over_twice_the_bounds_frames_not_the_frame_cap() {
+    // 73 units wide at 250 fps with air acceleration 10, entered at 1396 ups with 213 units of straight
+    // leg before an 89-degree turn: no greedy run is valid, and the fastest (the seed) runs on to the
+    // frame cap, 15,000 frames, without reaching the line. Planned over all of those frames, each count
+    // of the relaxed stage took 8 to 48 s, and the search grew the count three times (141 s in all) to
+    // end where it now ends in under a second: no valid plan.
+    let family = GeneratorSettings {
+        fps: vec![250],
+        airaccelerate: vec![10],
+        ..GeneratorSettings::ci_sized()
+    };
+    let g = generate(3131, 11, &family).unwrap_or_else(|e| panic!("{e}"));
+    let mut bound_frames = 0;
+    let mut counts = Vec::new();
+    let o = solve_with_progress(
+        &g.scene,
+        &SearchSettings::for_quality(Quality::Fast),
+        &mut |p| match p {
+            Progress::Baseline {
+                greedy_frames,
+                bound_frames: b,
+            } => {
+                assert_eq!(greedy_frames, None, "a greedy run finished");
+                bound_frames = b as usize;
+            }
+            Progress::FrameCount { frames, .. } => counts.push(frames),
+            _ => {}
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(!o.trace.feasible() || o.trace.crossing.is_none());
+    let (first, most) = (counts[0], counts.iter().copied().max().unwrap_or(0));
+    assert!(
+        first <= 2 * bound_frames && most <= 3 * bound_frames,
+        "counts {counts:?} against the bound's {bound_frames} frames"
+    );
 }

@@ -39,6 +39,13 @@ const CAP_WIDTHS_UNITS: [f64; 5] = [16.0, 32.0, 64.0, 128.0, 256.0];
 /// given up (ranked by how far it got).
 const BROKEN_RUN_BOUND_FACTOR: u64 = 2;
 
+/// The frame after which a run still short of the line is given up: [`BROKEN_RUN_BOUND_FACTOR`] times
+/// the lower bound's crossing frame. The baseline ranks an invalid greedy run by how far it got by then,
+/// and a search started from a run that never reaches the line plans no more frames than that at first.
+pub(super) fn given_up_frame(bound: &LowerBound) -> u64 {
+    BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames.max(1)
+}
+
 /// The distinct clean runs kept as starts of the relaxed problem, at most.
 pub(super) const MAX_STARTS: usize = 4;
 
@@ -333,7 +340,7 @@ pub(super) fn baseline(
     };
     let mut runs = GuideRuns::default();
     // An invalid run is ranked by when it crosses; one still going at this frame is given up.
-    let broken_frame_limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames.max(1);
+    let broken_frame_limit = given_up_frame(bound);
     sweep_guides(
         sim,
         &guides,
@@ -707,7 +714,7 @@ mod tests {
         plain: bool,
     ) -> (f64, GreedyGuide) {
         let mut runs = GuideRuns::default();
-        let limit = BROKEN_RUN_BOUND_FACTOR * bound.crossing.frames;
+        let limit = given_up_frame(bound);
         let guides = guide_paths(scene, bound);
         let budget = Budget::unlimited();
         sweep_guides(sim, &guides, cornering, plain, limit, &budget, &mut runs);

@@ -14,7 +14,7 @@
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
 use super::airborne::plan_airborne;
-use super::baseline::{baseline, corner_caps, GreedyGuide, GuideRun};
+use super::baseline::{baseline, corner_caps, given_up_frame, GreedyGuide, GuideRun};
 use super::bound::{frame_limited_scene, lower_bound_within};
 use super::planner::Planner;
 use super::relaxed::RelaxedCertificate;
@@ -474,9 +474,15 @@ fn solve_once(
     let mut planner = Planner::new(scene, &sim, settings, &bound, seed, budget);
     let warm = planner.warm_start(seed);
     let prefix_len = planner.prefix.len();
-    let n = seed.crossing.map_or(warm.len(), |c| {
-        (c.frames as usize).saturating_sub(prefix_len)
-    });
+    // A seed that never reaches the line (no greedy run is valid) ran to the frame cap: planned over
+    // that many frames, each count of the search would take minutes. It is planned over as many frames
+    // as the baseline gives an invalid run, and the search grows the count from there if need be.
+    let given_up = usize::try_from(given_up_frame(&bound)).unwrap_or(usize::MAX);
+    let n = seed
+        .crossing
+        .map_or(warm.len().min(given_up.saturating_sub(prefix_len)), |c| {
+            (c.frames as usize).saturating_sub(prefix_len)
+        });
     // No plan crosses before the bound's frame.
     let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
     // Stages 2 to 4.
