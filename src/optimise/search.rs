@@ -475,8 +475,8 @@ fn solve_once(
     let warm = planner.warm_start(seed);
     let prefix_len = planner.prefix.len();
     // A seed that never reaches the line (no greedy run is valid) ran to the frame cap: planned over
-    // that many frames, each count of the search would take minutes. It is planned over as many frames
-    // as the baseline gives an invalid run, and the search grows the count from there if need be.
+    // that many frames, each count of the search takes tens of seconds. It is planned over as many
+    // frames as the baseline gives an invalid run, and the search grows the count from there if need be.
     let given_up = usize::try_from(given_up_frame(&bound)).unwrap_or(usize::MAX);
     let n = seed
         .crossing
