@@ -489,7 +489,9 @@ fn a_seed_that_never_reaches_the_line_is_planned_over_twice_the_bounds_frames_no
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert!(!o.trace.feasible() || o.trace.crossing.is_none());
-    let (first, most) = (counts[0], counts.iter().copied().max().unwrap_or(0));
+    let (Some(&first), Some(&most)) = (counts.first(), counts.iter().max()) else {
+        panic!("no frame count tried")
+    };
     assert!(
         first <= 2 * bound_frames && most <= 3 * bound_frames,
         "counts {counts:?} against the bound's {bound_frames} frames"

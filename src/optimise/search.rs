@@ -477,12 +477,13 @@ fn solve_once(
     // A seed that never reaches the line (no greedy run is valid) ran to the frame cap: planned over
     // that many frames, each count of the search takes tens of seconds. It is planned over as many
     // frames as the baseline gives an invalid run, and the search grows the count from there if need be.
-    let given_up = usize::try_from(given_up_frame(&bound)).unwrap_or(usize::MAX);
-    let n = seed
-        .crossing
-        .map_or(warm.len().min(given_up.saturating_sub(prefix_len)), |c| {
-            (c.frames as usize).saturating_sub(prefix_len)
-        });
+    let n = match seed.crossing {
+        Some(c) => (c.frames as usize).saturating_sub(prefix_len),
+        None => {
+            let given_up = usize::try_from(given_up_frame(&bound)).unwrap_or(usize::MAX);
+            warm.len().min(given_up.saturating_sub(prefix_len))
+        }
+    };
     // No plan crosses before the bound's frame.
     let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
     // Stages 2 to 4.
