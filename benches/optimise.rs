@@ -1,5 +1,6 @@
 //! What the optimiser's pieces cost (issue 8): the greedy strafer over 10,000 frames, the lower bound of a
-//! bend, one Clarabel sub-step, and a whole `solve --quality fast`. `strafeopt bench` measures accuracy
+//! bend, one sub-step (solved frame by frame and by Clarabel, at 100 and 1000 fps), and a whole `solve
+//! --quality fast`. `strafeopt bench` measures accuracy
 //! against wall time on whole scenes; these are the speed targets.
 //!
 //! CI runs each once in test mode (`cargo test --release --benches`).
@@ -7,6 +8,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 use std::time::Duration;
+use strafeopt::optimise::qp::SubProblemSolver;
 use strafeopt::optimise::substep::SubStepSetup;
 use strafeopt::optimise::{lower_bound, solve, Quality, SearchSettings};
 use strafeopt::physics::Vec2;
@@ -14,6 +16,7 @@ use strafeopt::scene::Scene;
 use strafeopt::sim::{Greedy, Simulation};
 
 const BEND: &str = include_str!("../scenarios/hl-bend90-100fps.toml");
+const BEND_1000: &str = include_str!("../scenarios/hl-bend90-1000fps.toml");
 
 /// A 1000 fps airborne lane too long to finish in the 10,000-frame cap: every run is 10,000 frames.
 const LANE: &str = r#"
@@ -63,12 +66,22 @@ fn bench_strafer_and_bound(c: &mut Criterion) {
 fn bench_optimiser(c: &mut Criterion) {
     let bend = scene(BEND, "hl-bend90-100fps.toml");
     let fast = SearchSettings::for_quality(Quality::Fast);
-    let setup = SubStepSetup::greedy(&bend, &fast).unwrap_or_else(|e| panic!("{e}"));
     let mut g = c.benchmark_group("optimiser");
     g.sample_size(10).measurement_time(Duration::from_secs(5));
-    g.bench_function("clarabel_substep_bend90_100fps", |b| {
-        b.iter(|| black_box(setup.solve().predicted))
-    });
+    // The first sub-step around the greedy run, by each solver: 402 frames at 100 fps, 3479 at 1000.
+    let bend_1000 = scene(BEND_1000, "hl-bend90-1000fps.toml");
+    for (fps, scene) in [(100, &bend), (1000, &bend_1000)] {
+        let mut setup = SubStepSetup::greedy(scene, &fast).unwrap_or_else(|e| panic!("{e}"));
+        for (name, solver) in [
+            ("riccati", SubProblemSolver::Riccati),
+            ("clarabel", SubProblemSolver::Clarabel),
+        ] {
+            setup.solver = solver;
+            g.bench_function(format!("{name}_substep_bend90_{fps}fps"), |b| {
+                b.iter(|| black_box(setup.solve().predicted))
+            });
+        }
+    }
     g.warm_up_time(Duration::from_millis(100));
     // A full solve per quality level on the 100 fps bend. The other bends take a minute or more per solve:
     // `strafeopt bench` measures them (CI runs these benches once each in test mode).

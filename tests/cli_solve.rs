@@ -154,3 +154,47 @@ fn bad_time_limit_is_exit_2() {
         assert!(String::from_utf8_lossy(&out.stderr).contains("--time-limit"));
     }
 }
+
+#[test]
+fn the_sub_problem_solver_is_chosen_on_the_command_line() {
+    // Both solvers solve the same convex sub-problems; their steps differ within the tolerances, and on
+    // the 90-degree bend the searches end in two local optima of one frame, 0.25 ms apart (measured:
+    // 4.001590 s frame by frame, 4.001339 s with Clarabel). A flag that did not reach the search would
+    // give one plan twice.
+    let plan = |solver: &str| {
+        let out = strafeopt(&[
+            "solve",
+            "scenarios/hl-bend90-100fps.toml",
+            "--quality",
+            "fast",
+            "--sub-problem-solver",
+            solver,
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(v["feasible"], true, "{solver}");
+        assert_eq!(v["engine_exact"]["feasible"], true, "{solver}");
+        (v["frames"].as_u64(), v["time"].as_f64().unwrap_or(f64::NAN))
+    };
+    let (riccati, clarabel) = (plan("riccati"), plan("clarabel"));
+    assert_eq!(riccati.0, Some(401));
+    assert_eq!(clarabel.0, Some(401));
+    assert!(
+        (riccati.1 - clarabel.1).abs() > 1e-4,
+        "{riccati:?} {clarabel:?}"
+    );
+    let out = strafeopt(&[
+        "solve",
+        "scenarios/hl-bend90-100fps.toml",
+        "--sub-problem-solver",
+        "qdldl",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("riccati") && err.contains("clarabel"), "{err}");
+}

@@ -5,10 +5,10 @@
 //! Wall times are measured around each solve with [`Instant`]: measurements, not targets.
 
 use crate::geometry::BoundaryKind;
-use crate::optimise::{solve, Quality, SearchSettings};
+use crate::optimise::{solve, SearchSettings};
 use crate::scene::generate::{GeneratedScene, SceneKind};
 use serde::Serialize;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// One generated scene solved.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -121,18 +121,12 @@ impl SceneRecord {
     }
 }
 
-/// Solves `g` at `quality` (with an optional time limit) and records the outcome; a solve that fails is
+/// Solves `g` with `settings` and records the outcome; a solve that fails is
 /// a record with its error as the status, not an error.
-pub fn measure_generated_scene(
-    g: &GeneratedScene,
-    quality: Quality,
-    time_limit: Option<Duration>,
-) -> SceneRecord {
+pub fn measure_generated_scene(g: &GeneratedScene, settings: &SearchSettings) -> SceneRecord {
     let mut r = SceneRecord::new(g);
-    let mut settings = SearchSettings::for_quality(quality);
-    settings.time_limit = time_limit;
     let started = Instant::now();
-    let outcome = solve(&g.scene, &settings);
+    let outcome = solve(&g.scene, settings);
     r.solve_seconds = started.elapsed().as_secs_f64();
     let out = match outcome {
         Ok(out) => out,
@@ -188,15 +182,14 @@ pub fn measure_generated_scene(
 /// [`measure_generated_scene`] on each scene in turn, calling `progress` with each record.
 pub fn measure_generated(
     scenes: &[GeneratedScene],
-    quality: Quality,
-    time_limit: Option<Duration>,
+    settings: &SearchSettings,
     progress: &mut dyn FnMut(usize, &SceneRecord),
 ) -> Vec<SceneRecord> {
     scenes
         .iter()
         .enumerate()
         .map(|(i, g)| {
-            let r = measure_generated_scene(g, quality, time_limit);
+            let r = measure_generated_scene(g, settings);
             progress(i, &r);
             r
         })

@@ -102,6 +102,26 @@ pub enum QualityArg {
     Exact,
 }
 
+/// Solvers of the convexified sub-steps (`SubProblemSolver`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SubProblemSolverArg {
+    /// Frame by frame (a Riccati recursion inside an interior-point method), Clarabel where it gives
+    /// no solution.
+    Riccati,
+    /// Clarabel on every sub-problem (slower; the same problems, for comparison).
+    Clarabel,
+}
+
+impl SubProblemSolverArg {
+    /// The library's solver.
+    pub fn solver(self) -> crate::optimise::qp::SubProblemSolver {
+        match self {
+            SubProblemSolverArg::Riccati => crate::optimise::qp::SubProblemSolver::Riccati,
+            SubProblemSolverArg::Clarabel => crate::optimise::qp::SubProblemSolver::Clarabel,
+        }
+    }
+}
+
 /// `strafeopt solve SCENE ...`
 #[derive(Debug, Args)]
 pub struct SolveArgs {
@@ -118,6 +138,9 @@ pub struct SolveArgs {
     /// is simulated further (default 100000, about 1.2 GB at the peak; see docs/limits.md).
     #[arg(long)]
     pub max_frames: Option<u64>,
+    /// Solver of the convexified sub-steps.
+    #[arg(long, value_enum, default_value_t = SubProblemSolverArg::Riccati)]
+    pub sub_problem_solver: SubProblemSolverArg,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub artifacts: ArtifactFlags,

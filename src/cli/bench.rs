@@ -4,7 +4,7 @@
 //! `--generated N` it solves N generated scenes instead ([`super::bench_generated`]), with
 //! `--staircase C,...` staircases of C corners ([`super::bench_staircase`]).
 
-use super::args::QualityArg;
+use super::args::{QualityArg, SubProblemSolverArg};
 use super::table::{aligned_line, column_widths};
 use super::{progress, write_atomically};
 use crate::bench::{
@@ -13,7 +13,7 @@ use crate::bench::{
 };
 use crate::error::{Error, Result};
 use crate::optimise::search::time_limit;
-use crate::optimise::Quality;
+use crate::optimise::{Quality, SearchSettings};
 use crate::scene::{Scene, SceneFile};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -74,12 +74,24 @@ pub struct BenchArgs {
     /// Quality of each solve with --generated or --staircase (default fast).
     #[arg(long, value_enum, required = false)]
     pub quality: Option<QualityArg>,
+    /// Solver of the convexified sub-steps, with --generated or --staircase.
+    #[arg(long, value_enum, default_value_t = SubProblemSolverArg::Riccati)]
+    pub sub_problem_solver: SubProblemSolverArg,
     /// With --generated: flags that narrow the family, as for `strafeopt gen`.
     #[command(flatten)]
     pub family: super::gen::FamilyFlags,
     /// Print no progress on stderr.
     #[arg(long, short = 'q')]
     pub quiet: bool,
+}
+
+/// The search settings of each solve of `--generated` or `--staircase`: the level's, with the time
+/// limit and the sub-problems' solver given.
+pub fn search_settings(args: &BenchArgs, q: Quality) -> Result<SearchSettings> {
+    let mut settings = SearchSettings::for_quality(q);
+    settings.time_limit = args.time_limit.map(time_limit).transpose()?;
+    settings.sub_problem_solver = args.sub_problem_solver.solver();
+    Ok(settings)
 }
 
 /// The library's quality level.

@@ -2,7 +2,7 @@
 //! the generated family ([`crate::bench::generated`]) and prints the distribution of each column, the
 //! share of scenes where greedy and the plan finished validly, and (`--json`) a record per scene.
 
-use super::bench::{quality, BenchArgs};
+use super::bench::{quality, search_settings, BenchArgs};
 use super::gen::checked_count;
 use super::table::aligned_table;
 use crate::bench::generated::{
@@ -10,7 +10,6 @@ use crate::bench::generated::{
 };
 use crate::bench::quality_name;
 use crate::error::{Error, Result};
-use crate::optimise::search::time_limit;
 use crate::optimise::Quality;
 use crate::scene::generate::generate_sample;
 use std::io::IsTerminal;
@@ -46,10 +45,10 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     let settings = args.family.settings()?;
     let seed = args.seed.unwrap_or(DEFAULT_SEED);
     let q = args.quality.map_or(Quality::Fast, quality);
-    let limit = args.time_limit.map(time_limit).transpose()?;
+    let search = search_settings(args, q)?;
     let scenes = generate_sample(seed, count, &settings)?;
     let show = std::io::stderr().is_terminal() && !args.json;
-    let records = measure_generated(&scenes, q, limit, &mut progress_lines(show, count));
+    let records = measure_generated(&scenes, &search, &mut progress_lines(show, count));
     let dist = distributions(&records, &columns());
     let greedy = share(&records, |r| r.greedy_valid);
     let plan = share(&records, |r| r.valid);
@@ -65,6 +64,7 @@ pub fn run(args: &BenchArgs) -> Result<String> {
             "seed": seed,
             "count": count,
             "quality": quality_name(q),
+            "sub_problem_solver": search.sub_problem_solver,
             "family": settings,
             "distributions": dist,
             "greedy_valid": greedy.0,

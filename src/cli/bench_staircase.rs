@@ -8,7 +8,6 @@ use super::table::aligned_table;
 use crate::bench::generated::{measure_generated, SceneRecord};
 use crate::bench::quality_name;
 use crate::error::{Error, Result};
-use crate::optimise::search::time_limit;
 use crate::optimise::Quality;
 use crate::scene::generate::{staircase, GeneratedScene, Staircase};
 use std::io::IsTerminal;
@@ -39,13 +38,14 @@ pub fn run(args: &BenchArgs) -> Result<String> {
         .map(|&corners| staircase(&Staircase { corners, ..spec }))
         .collect::<Result<_>>()?;
     let q = args.quality.map_or(Quality::Fast, quality);
-    let limit = args.time_limit.map(time_limit).transpose()?;
+    let search = super::bench::search_settings(args, q)?;
     let show = std::io::stderr().is_terminal() && !args.json && !args.quiet;
     let count = scenes.len() as u64;
-    let records = measure_generated(&scenes, q, limit, &mut progress_lines(show, count));
+    let records = measure_generated(&scenes, &search, &mut progress_lines(show, count));
     if args.json {
         let value = serde_json::json!({
             "quality": quality_name(q),
+            "sub_problem_solver": search.sub_problem_solver,
             "leg_units": spec.leg_units,
             "width_units": spec.width_units,
             "fps": spec.fps,

@@ -24,6 +24,7 @@ pub fn run(args: &SolveArgs) -> Result<String> {
     if let Some(n) = args.max_frames {
         settings.max_frames = max_frames(n)?;
     }
+    settings.sub_problem_solver = args.sub_problem_solver.solver();
     // The whole command's budget: the solve, then writing the files.
     let budget = Budget::from_limit(settings.time_limit, None);
     let scene = Scene::load(&args.scene)?;

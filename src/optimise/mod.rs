@@ -18,6 +18,7 @@ mod relaxed;
 mod rounding;
 pub mod scp;
 pub mod search;
+mod stagewise;
 pub mod substep;
 mod verify;
 

@@ -174,6 +174,7 @@ impl<'a> Planner<'a> {
             frames_per_knot,
             anglemod_guard: true,
             turn_less: false,
+            sub_problem_solver: self.settings.sub_problem_solver,
         }
     }
 
@@ -317,12 +318,22 @@ pub(super) fn with_fast_planner<R>(
     scene: &Scene,
     test: impl FnOnce(&mut Planner, &super::baseline::Baseline, &LowerBound) -> R,
 ) -> R {
-    let (sim, bound, base) = planning_inputs(scene);
     let settings = super::search::SearchSettings::for_quality(super::Quality::Fast);
+    with_planner(scene, &settings, test)
+}
+
+/// [`with_fast_planner`] with the given settings.
+#[cfg(test)]
+pub(super) fn with_planner<R>(
+    scene: &Scene,
+    settings: &super::search::SearchSettings,
+    test: impl FnOnce(&mut Planner, &super::baseline::Baseline, &LowerBound) -> R,
+) -> R {
+    let (sim, bound, base) = planning_inputs(scene);
     let mut planner = Planner::new(
         scene,
         &sim,
-        &settings,
+        settings,
         &bound,
         base.seed(),
         Budget::unlimited(),

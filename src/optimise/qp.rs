@@ -1,6 +1,8 @@
 //! The convexified sub-step: the dynamics linearised around the current trajectory, the walls as
-//! separating half-planes, a trust region, and slack so that every sub-problem is feasible. Solved by
-//! Clarabel as `min 0.5 z'Pz + q'z  s.t.  Az + s = b, s in K`.
+//! separating half-planes, a trust region, and slack so that every sub-problem is feasible. A convex QP,
+//! solved frame by frame ([`super::stagewise`], by default) or by Clarabel as
+//! `min 0.5 z'Pz + q'z  s.t.  Az + s = b, s in K`; Clarabel also takes every sub-problem the
+//! frame-by-frame solver gives no solution for. Both read and write the same layout of variables.
 //!
 //! Variables, in order: the control changes `(d sigma_k, d c_k / C_SCALE)` of the controls with room to
 //! move (a control with none, a side fixed at `+-1`, is left out: its change is zero); per frame the
@@ -14,6 +16,7 @@
 
 use super::lagrangian::CurvatureBlock;
 use super::model::FrameJacobian;
+use super::stagewise;
 use crate::geometry::HalfPlane;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -66,6 +69,20 @@ pub struct SubProblem<'a> {
     /// Per frame, a correction added to the position in its wall rows: a second-order correction's
     /// estimate of what the linearised dynamics leave out ([`super::scp`]); `None`: none.
     pub wall_shift: Option<&'a [crate::physics::Vec2]>,
+    /// The solver tried first.
+    pub solver: SubProblemSolver,
+}
+
+/// Which solver a sub-problem is given first.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SubProblemSolver {
+    /// Frame by frame: a Riccati recursion inside an interior-point method ([`super::stagewise`]),
+    /// which uses that the sub-problem is a chain of frames; Clarabel where it gives no solution.
+    #[default]
+    Riccati,
+    /// Clarabel, a general sparse conic solver, on every sub-problem.
+    Clarabel,
 }
 
 /// How a sub-problem ended, mapped from Clarabel's status in one place.
@@ -113,10 +130,10 @@ impl SubStep {
     }
 }
 
-/// Clarabel's duality gap tolerance (absolute and relative) on a sub-problem.
-const SUBPROBLEM_GAP_TOL: f64 = 1e-6;
-/// Clarabel's feasibility tolerance on a sub-problem.
-const SUBPROBLEM_FEAS_TOL: f64 = 1e-7;
+/// The duality gap tolerance (absolute and relative) on a sub-problem.
+pub(super) const SUBPROBLEM_GAP_TOL: f64 = 1e-6;
+/// The feasibility tolerance on a sub-problem.
+pub(super) const SUBPROBLEM_FEAS_TOL: f64 = 1e-7;
 
 /// Interior-point iterations Clarabel may take on one sub-problem.
 pub const MAX_SUBPROBLEM_ITERATIONS: u32 = 200;
@@ -138,52 +155,203 @@ pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
     solve_limited(sp, max_iterations, f64::INFINITY)
 }
 
-/// [`solve`] with Clarabel's iteration cap and time limit, seconds.
+/// [`solve`] with the iteration cap and time limit, seconds: by [`SubProblem::solver`], then by Clarabel
+/// where the frame-by-frame solver gives no solution.
 fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> SubStep {
-    let n = sp.jacobians.len();
-    // One slack per group of wall rows, numbered in order of first appearance.
-    let mut slack_of_group: Vec<Option<usize>> = Vec::new();
-    let mut row_slack: Vec<usize> = Vec::with_capacity(sp.walls.len());
-    let mut m_w = 0;
-    for w in sp.walls {
-        if slack_of_group.len() <= w.group {
-            slack_of_group.resize(w.group + 1, None);
+    let layout = Layout::of(sp);
+    let rhs = wall_rhs(sp);
+    let started = std::time::Instant::now();
+    let staged = match sp.solver {
+        SubProblemSolver::Riccati => {
+            stagewise::solve(&layout.staged(sp, &rhs), max_iterations, time_limit_s).ok()
         }
-        let slack = *slack_of_group[w.group].get_or_insert_with(|| {
-            m_w += 1;
-            m_w - 1
-        });
-        row_slack.push(slack);
-    }
-    // A control whose allowed change is empty (a side fixed at +-1, a frame held on the kink) is no
-    // variable at all: its change is zero. (A box of zero width has no interior, which costs the
-    // interior-point method many iterations; an equality row for it would only make the system larger.)
-    // Each control's allowed change `[-lo, hi]`, scaled.
-    let control_ranges = |k: usize| {
-        let (slo, shi) = sp.sigma_range[k];
-        let (clo, chi) = sp.c_range[k];
-        [
-            (slo.max(0.0), shi.max(0.0)),
-            (clo.max(0.0) / C_SCALE_UPS, chi.max(0.0) / C_SCALE_UPS),
-        ]
+        SubProblemSolver::Clarabel => None,
     };
-    // The variable of control `j` of frame `k`, at `2 k + j`; `None`: fixed.
-    let mut control_var: Vec<Option<usize>> = Vec::with_capacity(2 * n);
-    let mut nu = 0;
-    for k in 0..n {
-        for (lo, hi) in control_ranges(k) {
-            control_var.push((lo + hi > FIXED_RANGE).then(|| {
-                nu += 1;
-                nu - 1
-            }));
+    let solution = match staged {
+        Some(s) => Solution {
+            status: SubStepStatus::Solved { almost: s.almost },
+            x: s.x,
+            z: s.dynamics_duals.into_iter().flatten().collect(),
+        },
+        None => {
+            let left_s = time_limit_s - started.elapsed().as_secs_f64();
+            match clarabel_solved(sp, &layout, &rhs, max_iterations, left_s) {
+                Ok(solution) if solution.x.len() == layout.n_vars() => solution,
+                Ok(_) => {
+                    return SubStep::failed(SubStepStatus::Failed(
+                        "solution of the wrong size".into(),
+                    ))
+                }
+                Err(no) => return SubStep::failed(SubStepStatus::Failed(no.to_string())),
+            }
+        }
+    };
+    sub_step_of(sp, &layout, solution)
+}
+
+/// Where each variable of a sub-problem sits: the free controls first, then `4 n` state changes, then
+/// one slack per group of wall rows.
+struct Layout {
+    /// Per frame `k` and control `j`, at `2 k + j`, its variable; `None`: fixed.
+    control_var: Vec<Option<usize>>,
+    /// Free controls.
+    n_controls: usize,
+    /// Frames.
+    n_frames: usize,
+    /// Per wall row, its slack.
+    row_slack: Vec<usize>,
+    /// Slacks (groups of wall rows).
+    n_slacks: usize,
+    /// Per frame, each control's allowed change `[-lo, hi]`, scaled.
+    ranges: Vec<[(f64, f64); 2]>,
+}
+
+impl Layout {
+    fn of(sp: &SubProblem) -> Layout {
+        let n = sp.jacobians.len();
+        // One slack per group of wall rows, numbered in order of first appearance.
+        let mut slack_of_group: Vec<Option<usize>> = Vec::new();
+        let mut row_slack: Vec<usize> = Vec::with_capacity(sp.walls.len());
+        let mut n_slacks = 0;
+        for w in sp.walls {
+            if slack_of_group.len() <= w.group {
+                slack_of_group.resize(w.group + 1, None);
+            }
+            let slack = *slack_of_group[w.group].get_or_insert_with(|| {
+                n_slacks += 1;
+                n_slacks - 1
+            });
+            row_slack.push(slack);
+        }
+        let ranges: Vec<[(f64, f64); 2]> = (0..n)
+            .map(|k| {
+                let (slo, shi) = sp.sigma_range[k];
+                let (clo, chi) = sp.c_range[k];
+                [
+                    (slo.max(0.0), shi.max(0.0)),
+                    (clo.max(0.0) / C_SCALE_UPS, chi.max(0.0) / C_SCALE_UPS),
+                ]
+            })
+            .collect();
+        // A control whose allowed change is empty (a side fixed at +-1, a frame held on the kink) is no
+        // variable at all: its change is zero. (A box of zero width has no interior, which costs an
+        // interior-point method many iterations; an equality row for it would only make the system
+        // larger.)
+        let mut control_var: Vec<Option<usize>> = Vec::with_capacity(2 * n);
+        let mut n_controls = 0;
+        for range in &ranges {
+            for (lo, hi) in range {
+                control_var.push((lo + hi > FIXED_RANGE).then(|| {
+                    n_controls += 1;
+                    n_controls - 1
+                }));
+            }
+        }
+        Layout {
+            control_var,
+            n_controls,
+            n_frames: n,
+            row_slack,
+            n_slacks,
+            ranges,
         }
     }
-    let iu = |k: usize, j: usize| control_var[2 * k + j];
-    let nx = 4 * n;
-    let nvar = nu + nx + m_w;
-    let ix = |k: usize, i: usize| nu + 4 * k + i;
-    let is = |j: usize| nu + nx + j;
 
+    /// The variable of control `j` of frame `k`; `None`: fixed.
+    fn iu(&self, k: usize, j: usize) -> Option<usize> {
+        self.control_var[2 * k + j]
+    }
+
+    /// The variable of state change `i` after frame `k`.
+    fn ix(&self, k: usize, i: usize) -> usize {
+        self.n_controls + 4 * k + i
+    }
+
+    /// The variable of slack `j`.
+    fn is(&self, j: usize) -> usize {
+        self.n_controls + 4 * self.n_frames + j
+    }
+
+    fn n_vars(&self) -> usize {
+        self.n_controls + 4 * self.n_frames + self.n_slacks
+    }
+
+    /// The sub-problem as a chain of frames for [`stagewise::solve`], laid out as here.
+    fn staged<'a>(&'a self, sp: &SubProblem<'a>, rhs: &'a [f64]) -> stagewise::StagedProblem<'a> {
+        stagewise::StagedProblem {
+            jacobians: sp.jacobians,
+            control_var: &self.control_var,
+            n_controls: self.n_controls,
+            control_ranges: &self.ranges,
+            walls: sp.walls,
+            wall_rhs: rhs,
+            row_slack: &self.row_slack,
+            n_slacks: self.n_slacks,
+            slack_weight: sp.slack_weight,
+            terminal_gradient: [-sp.progress_dir.x, -sp.progress_dir.y, 0.0, 0.0],
+            curvature: sp.curvature,
+        }
+    }
+
+    /// Per frame `k`, the variables of the curvature block's inputs `(V_{k-1}, psi_{k-1}, sigma_k,
+    /// c_k)` with their scales.
+    fn curvature_vars(&self, k: usize) -> [Option<(usize, f64)>; 4] {
+        [
+            (k > 0).then(|| (self.ix(k.saturating_sub(1), 2), 1.0)),
+            (k > 0).then(|| (self.ix(k.saturating_sub(1), 3), 1.0)),
+            self.iu(k, 0).map(|v| (v, 1.0)),
+            self.iu(k, 1).map(|v| (v, C_SCALE_UPS)),
+        ]
+    }
+}
+
+/// Per wall row, its right-hand side: the clearance of the current position (moved by the wall shift)
+/// less the margin, units.
+fn wall_rhs(sp: &SubProblem) -> Vec<f64> {
+    sp.walls
+        .iter()
+        .map(|w| {
+            let shift = sp
+                .wall_shift
+                .and_then(|e| e.get(w.frame).copied())
+                .unwrap_or_default();
+            w.plane.side(sp.positions[w.frame] + shift) - sp.margin
+        })
+        .collect()
+}
+
+/// The sub-problem solved by Clarabel: built in its form and run ([`clarabel_solution`]).
+fn clarabel_solved(
+    sp: &SubProblem,
+    layout: &Layout,
+    rhs: &[f64],
+    max_iterations: u32,
+    time_limit_s: f64,
+) -> std::result::Result<Solution, NoSolution> {
+    let (a, b, cones) = clarabel_rows(sp, layout, rhs);
+    let (p, q) = clarabel_objective(sp, layout);
+    let problem = ClarabelProblem {
+        p: &p,
+        q: &q,
+        a: &a,
+        b: &b,
+        cones: &cones,
+    };
+    clarabel_solution(&problem, max_iterations, time_limit_s)
+}
+
+/// The rows `A z + s = b, s in K`: the linearised dynamics (zero cone, one block per frame), then the
+/// wall rows, the slacks' signs and the controls' boxes (nonnegative cone).
+fn clarabel_rows(
+    sp: &SubProblem,
+    layout: &Layout,
+    rhs: &[f64],
+) -> (CscMatrix<f64>, Vec<f64>, Vec<SupportedConeT<f64>>) {
+    let (iu, ix, is) = (
+        |k, j| layout.iu(k, j),
+        |k, i| layout.ix(k, i),
+        |j| layout.is(j),
+    );
     let (mut ri, mut ci, mut vals): (Vec<usize>, Vec<usize>, Vec<f64>) = (vec![], vec![], vec![]);
     let mut b: Vec<f64> = Vec::new();
     let mut row = 0usize;
@@ -219,21 +387,15 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     }
     let n_eq = row;
     // Walls: -n . dp_k - s_j <= n . p_k - offset - margin.
-    for (j, w) in sp.walls.iter().enumerate() {
-        let shift = sp
-            .wall_shift
-            .and_then(|e| e.get(w.frame).copied())
-            .unwrap_or_default();
-        let p = sp.positions[w.frame] + shift;
+    for ((w, &slack), &rhs) in sp.walls.iter().zip(&layout.row_slack).zip(rhs) {
         ri.extend([row, row, row]);
-        ci.extend([ix(w.frame, 0), ix(w.frame, 1), is(row_slack[j])]);
+        ci.extend([ix(w.frame, 0), ix(w.frame, 1), is(slack)]);
         vals.extend([-w.plane.normal.x, -w.plane.normal.y, -1.0]);
-        let rhs = w.plane.side(p) - sp.margin;
         b.push(rhs);
         row += 1;
     }
     // Slacks are nonnegative.
-    for j in 0..m_w {
+    for j in 0..layout.n_slacks {
         ri.push(row);
         ci.push(is(j));
         vals.push(-1.0);
@@ -241,44 +403,36 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         row += 1;
     }
     // Trust region and bounds on the controls that may move.
-    for k in 0..n {
-        for (j, (lo, hi)) in control_ranges(k).into_iter().enumerate() {
+    for (k, range) in layout.ranges.iter().enumerate() {
+        for (j, &(lo, hi)) in range.iter().enumerate() {
             let Some(var) = iu(k, j) else {
                 continue;
             };
-            ri.push(row);
-            ci.push(var);
-            vals.push(1.0);
-            b.push(hi);
-            row += 1;
-            ri.push(row);
-            ci.push(var);
-            vals.push(-1.0);
-            b.push(lo);
-            row += 1;
+            ri.extend([row, row + 1]);
+            ci.extend([var, var]);
+            vals.extend([1.0, -1.0]);
+            b.extend([hi, lo]);
+            row += 2;
         }
     }
-    let n_ineq = row - n_eq;
+    let a = CscMatrix::new_from_triplets(row, layout.n_vars(), ri, ci, vals);
+    let cones = vec![ZeroConeT(n_eq), NonnegativeConeT(row - n_eq)];
+    (a, b, cones)
+}
 
-    let a = CscMatrix::new_from_triplets(row, nvar, ri, ci, vals);
-    // P: regularisation of the control changes (diagonal), plus the curvature blocks (upper triangle;
-    // Clarabel sums repeated entries).
+/// The objective `0.5 z' P z + q' z`: the regularisation of the control changes (diagonal) and the
+/// curvature blocks (upper triangle; Clarabel sums repeated entries), minus the progress of the last
+/// position, and the slacks' weight.
+fn clarabel_objective(sp: &SubProblem, layout: &Layout) -> (CscMatrix<f64>, Vec<f64>) {
+    let (n, nu, nvar) = (layout.n_frames, layout.n_controls, layout.n_vars());
     let (mut pr, mut pc, mut pv): (Vec<usize>, Vec<usize>, Vec<f64>) = (
         (0..nu).collect(),
         (0..nu).collect(),
         vec![CONTROL_REGULARISATION; nu],
     );
-    let curvature_vars = |k: usize| -> [Option<(usize, f64)>; 4] {
-        [
-            (k > 0).then(|| (ix(k.saturating_sub(1), 2), 1.0)),
-            (k > 0).then(|| (ix(k.saturating_sub(1), 3), 1.0)),
-            iu(k, 0).map(|v| (v, 1.0)),
-            iu(k, 1).map(|v| (v, C_SCALE_UPS)),
-        ]
-    };
     if let Some(blocks) = sp.curvature {
         for (k, w) in blocks.iter().enumerate().take(n) {
-            let vars = curvature_vars(k);
+            let vars = layout.curvature_vars(k);
             for (i, vi) in vars.iter().enumerate() {
                 for (j, vj) in vars.iter().enumerate() {
                     if let (Some((a, sa)), Some((b, sb))) = (vi, vj) {
@@ -295,70 +449,37 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     let p = CscMatrix::new_from_triplets(nvar, nvar, pr, pc, pv);
     let mut q = vec![0.0; nvar];
     if n > 0 {
-        q[ix(n - 1, 0)] = -sp.progress_dir.x;
-        q[ix(n - 1, 1)] = -sp.progress_dir.y;
+        q[layout.ix(n - 1, 0)] = -sp.progress_dir.x;
+        q[layout.ix(n - 1, 1)] = -sp.progress_dir.y;
     }
-    for j in 0..m_w {
-        q[is(j)] = sp.slack_weight;
+    for j in 0..layout.n_slacks {
+        q[layout.is(j)] = sp.slack_weight;
     }
-    let cones: Vec<SupportedConeT<f64>> = vec![ZeroConeT(n_eq), NonnegativeConeT(n_ineq)];
-    let problem = ClarabelProblem {
-        p: &p,
-        q: &q,
-        a: &a,
-        b: &b,
-        cones: &cones,
-    };
-    let solution = match clarabel_solution(&problem, max_iterations, time_limit_s) {
-        Ok(solution) if solution.x.len() == nvar => solution,
-        Ok(_) => {
-            return SubStep::failed(SubStepStatus::Failed("solution of the wrong size".into()))
-        }
-        Err(no) => return SubStep::failed(SubStepStatus::Failed(no.to_string())),
-    };
-    // The step is judged on what its control changes do: Clarabel meets the dynamics rows only to its
+    (p, q)
+}
+
+/// The sub-step of a solution: its control changes, the state changes they give, what the model
+/// predicts the step gains, and the duals of the dynamics rows.
+fn sub_step_of(sp: &SubProblem, layout: &Layout, solution: Solution) -> SubStep {
+    let n = layout.n_frames;
+    // The step is judged on what its control changes do: a solver meets the dynamics rows only to its
     // feasibility tolerance, and along a chain of thousands of frames their residuals add up.
-    let x = with_the_states_of_its_controls(sp.jacobians, solution.x, iu, ix);
+    let x = with_the_states_of_its_controls(
+        sp.jacobians,
+        solution.x,
+        |k, j| layout.iu(k, j),
+        |k, i| layout.ix(k, i),
+    );
     let du: Vec<(f64, f64)> = (0..n)
         .map(|k| {
-            let change = |j: usize| iu(k, j).map_or(0.0, |v| x[v]);
+            let change = |j: usize| layout.iu(k, j).map_or(0.0, |v| x[v]);
             (change(0), change(1) * C_SCALE_UPS)
         })
         .collect();
-    let dp = (0..n)
-        .map(|k| crate::physics::Vec2::new(x[ix(k, 0)], x[ix(k, 1)]))
+    let dp: Vec<crate::physics::Vec2> = (0..n)
+        .map(|k| crate::physics::Vec2::new(x[layout.ix(k, 0)], x[layout.ix(k, 1)]))
         .collect();
-    let progress_gain = if n > 0 {
-        sp.progress_dir.x * x[ix(n - 1, 0)] + sp.progress_dir.y * x[ix(n - 1, 1)]
-    } else {
-        0.0
-    };
-    // The merit's violation, linearised: per group of wall rows (one move), how far its worst row is
-    // below the accepted clearance, before and after the step.
-    let mut worst_before = vec![0.0_f64; m_w];
-    let mut worst_after = vec![0.0_f64; m_w];
-    for (w, &slack) in sp.walls.iter().zip(&row_slack) {
-        let p = sp.positions[w.frame];
-        let side = w.plane.side(p);
-        let dp = w.plane.normal.x * x[ix(w.frame, 0)] + w.plane.normal.y * x[ix(w.frame, 1)];
-        worst_before[slack] = worst_before[slack].max(sp.accepted_clearance - side);
-        worst_after[slack] = worst_after[slack].max(sp.accepted_clearance - side - dp);
-    }
-    let viol_before: f64 = worst_before.iter().sum();
-    let viol_after: f64 = worst_after.iter().sum();
-    // The model's second-order term, 0.5 d' W d, over the curvature blocks.
-    let mut curvature_term = 0.0;
-    if let Some(blocks) = sp.curvature {
-        for (k, w) in blocks.iter().enumerate().take(n) {
-            let d: [f64; 4] = curvature_vars(k).map(|v| v.map_or(0.0, |(i, s)| x[i] * s));
-            for i in 0..4 {
-                for j in 0..4 {
-                    curvature_term += 0.5 * d[i] * w[i][j] * d[j];
-                }
-            }
-        }
-    }
-    let predicted = progress_gain + sp.slack_weight * (viol_before - viol_after) - curvature_term;
+    let predicted = predicted_gain(sp, layout, &x);
     let z = &solution.z;
     let dynamics_duals = (0..n)
         .map(|k| std::array::from_fn(|i| z.get(4 * k + i).copied().unwrap_or(0.0)))
@@ -370,6 +491,43 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
         predicted,
         dynamics_duals,
     }
+}
+
+/// The model's predicted decrease of the merit at the solution `x`: progress, less the weighted
+/// violation (per group of wall rows, one move, how far its worst row is below the accepted clearance,
+/// before and after the step), less the curvature term `0.5 d' W d`.
+fn predicted_gain(sp: &SubProblem, layout: &Layout, x: &[f64]) -> f64 {
+    let n = layout.n_frames;
+    let progress_gain = if n > 0 {
+        sp.progress_dir.x * x[layout.ix(n - 1, 0)] + sp.progress_dir.y * x[layout.ix(n - 1, 1)]
+    } else {
+        0.0
+    };
+    let mut worst_before = vec![0.0_f64; layout.n_slacks];
+    let mut worst_after = vec![0.0_f64; layout.n_slacks];
+    for (w, &slack) in sp.walls.iter().zip(&layout.row_slack) {
+        let side = w.plane.side(sp.positions[w.frame]);
+        let dp = w.plane.normal.x * x[layout.ix(w.frame, 0)]
+            + w.plane.normal.y * x[layout.ix(w.frame, 1)];
+        worst_before[slack] = worst_before[slack].max(sp.accepted_clearance - side);
+        worst_after[slack] = worst_after[slack].max(sp.accepted_clearance - side - dp);
+    }
+    let viol_before: f64 = worst_before.iter().sum();
+    let viol_after: f64 = worst_after.iter().sum();
+    let mut curvature_term = 0.0;
+    if let Some(blocks) = sp.curvature {
+        for (k, w) in blocks.iter().enumerate().take(n) {
+            let d: [f64; 4] = layout
+                .curvature_vars(k)
+                .map(|v| v.map_or(0.0, |(i, s)| x[i] * s));
+            for i in 0..4 {
+                for j in 0..4 {
+                    curvature_term += 0.5 * d[i] * w[i][j] * d[j];
+                }
+            }
+        }
+    }
+    progress_gain + sp.slack_weight * (viol_before - viol_after) - curvature_term
 }
 
 /// What Clarabel returned for a solved sub-problem: the primal `x` and the duals `z` (Clarabel's
@@ -575,18 +733,27 @@ mod tests {
             c_range: ranges,
             curvature: None,
             wall_shift: None,
+            solver: SubProblemSolver::Riccati,
         }
+    }
+
+    /// `sp` solved by each solver, the frame-by-frame one first.
+    fn by_each_solver(sp: &SubProblem) -> [SubStep; 2] {
+        [SubProblemSolver::Riccati, SubProblemSolver::Clarabel]
+            .map(|solver| solve(&SubProblem { solver, ..*sp }))
     }
 
     #[test]
     fn a_plain_sub_step_moves_to_the_trust_region_edge_of_progress() {
         let (j, p, w) = one_frame(jacobian(0.01), 10.0);
         let ranges = [(1.0, 1.0)];
-        let r = solve(&sub(&j, &p, &w, &ranges));
-        assert_eq!(r.status, SubStepStatus::Solved { almost: false });
-        // Progress is 0.01 per ups of c: c rises to its bound, +1 ups.
-        assert!((r.du[0].1 - 1.0).abs() < 1e-6, "{:?}", r.du);
-        assert!((r.predicted - 0.01).abs() < 1e-6, "{}", r.predicted);
+        for r in by_each_solver(&sub(&j, &p, &w, &ranges)) {
+            assert_eq!(r.status, SubStepStatus::Solved { almost: false });
+            // Progress is 0.01 per ups of c: c rises to its bound, +1 ups (to the duality gap's
+            // precision: the frame-by-frame solver stops 1.6e-6 ups short of it).
+            assert!((r.du[0].1 - 1.0).abs() < 1e-5, "{:?}", r.du);
+            assert!((r.predicted - 0.01).abs() < 1e-6, "{}", r.predicted);
+        }
     }
 
     #[test]
@@ -606,14 +773,15 @@ mod tests {
             c_range: &c_range,
             ..sub(&j, &p, &[], &sigma_range)
         };
-        let r = solve(&sp);
-        assert_eq!(r.status, SubStepStatus::Solved { almost: false });
-        assert_eq!((r.du[0].0, r.du[1].1), (0.0, 0.0), "{:?}", r.du);
-        assert!((r.du[0].1 - 1.0).abs() < 1e-6, "{:?}", r.du);
-        assert!((r.du[1].0 - 0.5).abs() < 1e-6, "{:?}", r.du);
-        // 2 per ups of frame 0's c, 3 per unit of frame 1's side.
-        assert!((r.predicted - (2.0 + 1.5)).abs() < 1e-5, "{}", r.predicted);
-        assert_eq!(r.dynamics_duals.len(), 2);
+        for r in by_each_solver(&sp) {
+            assert_eq!(r.status, SubStepStatus::Solved { almost: false });
+            assert_eq!((r.du[0].0, r.du[1].1), (0.0, 0.0), "{:?}", r.du);
+            assert!((r.du[0].1 - 1.0).abs() < 1e-6, "{:?}", r.du);
+            assert!((r.du[1].0 - 0.5).abs() < 1e-6, "{:?}", r.du);
+            // 2 per ups of frame 0's c, 3 per unit of frame 1's side.
+            assert!((r.predicted - (2.0 + 1.5)).abs() < 1e-5, "{}", r.predicted);
+            assert_eq!(r.dynamics_duals.len(), 2);
+        }
     }
 
     #[test]
@@ -624,13 +792,14 @@ mod tests {
         let jac = side_moves_up_and_along();
         let (j, p, w) = one_frame(jac, 0.5);
         let ranges = [(1.0, 1.0)];
-        let plain = solve(&sub(&j, &p, &w, &ranges));
+        let plain = by_each_solver(&sub(&j, &p, &w, &ranges));
         let left_out = [Vec2::new(0.0, 0.2)];
-        let shifted = solve(&SubProblem {
+        let shifted = by_each_solver(&SubProblem {
             wall_shift: Some(&left_out),
             ..sub(&j, &p, &w, &ranges)
         });
-        for (r, side) in [(&plain, 0.5), (&shifted, 0.3)] {
+        let cases = plain.iter().map(|r| (r, 0.5));
+        for (r, side) in cases.chain(shifted.iter().map(|r| (r, 0.3))) {
             assert_eq!(r.status, SubStepStatus::Solved { almost: false });
             assert!((r.du[0].0 - side).abs() < 1e-6, "{:?}", r.du);
             assert!((r.dp[0].y - side).abs() < 1e-6, "{:?}", r.dp);
@@ -641,7 +810,11 @@ mod tests {
     fn clarabel_out_of_iterations_is_a_failed_step_not_a_panic() {
         let (j, p, w) = one_frame(jacobian(0.01), 10.0);
         let ranges = [(1.0, 1.0)];
-        let r = solve_capped(&sub(&j, &p, &w, &ranges), 1);
+        let sp = SubProblem {
+            solver: SubProblemSolver::Clarabel,
+            ..sub(&j, &p, &w, &ranges)
+        };
+        let r = solve_capped(&sp, 1);
         assert!(
             matches!(r.status, SubStepStatus::Failed(ref s) if s.contains("MaxIterations")),
             "{:?}",
@@ -692,12 +865,13 @@ mod tests {
     fn non_finite_data_is_a_failed_step_not_a_panic() {
         let (j, p, w) = one_frame(jacobian(f64::NAN), 10.0);
         let ranges = [(1.0, 1.0)];
-        let r = solve(&sub(&j, &p, &w, &ranges));
-        assert!(
-            matches!(r.status, SubStepStatus::Failed(_)),
-            "{:?}",
-            r.status
-        );
+        for r in by_each_solver(&sub(&j, &p, &w, &ranges)) {
+            assert!(
+                matches!(r.status, SubStepStatus::Failed(_)),
+                "{:?}",
+                r.status
+            );
+        }
     }
 
     #[test]
@@ -722,22 +896,23 @@ mod tests {
                 slack_weight: 0.75,
                 ..sub(&j, &p, &w, &ranges)
             };
-            let r = solve(&sp);
-            assert!(matches!(r.status, SubStepStatus::Solved { .. }));
-            assert_eq!(
-                r.du[0].0 > 0.5,
-                sigma_rises,
-                "groups {groups:?}: {:?}",
-                r.du
-            );
-            // The prediction counts the move's worst row once: progress 1 less 0.75 per unit of
-            // the worst violation, or nothing gained the other way.
-            let expected = if sigma_rises {
-                1.0 - 0.75
-            } else {
-                -1.0 + 2.0 * 0.75
-            };
-            assert!((r.predicted - expected).abs() < 1e-5, "{}", r.predicted);
+            for r in by_each_solver(&sp) {
+                assert!(matches!(r.status, SubStepStatus::Solved { .. }));
+                assert_eq!(
+                    r.du[0].0 > 0.5,
+                    sigma_rises,
+                    "groups {groups:?}: {:?}",
+                    r.du
+                );
+                // The prediction counts the move's worst row once: progress 1 less 0.75 per unit of
+                // the worst violation, or nothing gained the other way.
+                let expected = if sigma_rises {
+                    1.0 - 0.75
+                } else {
+                    -1.0 + 2.0 * 0.75
+                };
+                assert!((r.predicted - expected).abs() < 1e-5, "{}", r.predicted);
+            }
         }
     }
 
@@ -747,13 +922,188 @@ mod tests {
         // stays feasible through its slack and reports the violation it could not remove.
         let (j, p, w) = one_frame(jacobian(0.01), -50.0);
         let ranges = [(1.0, 1.0)];
-        let r = solve(&sub(&j, &p, &w, &ranges));
-        assert!(
-            matches!(r.status, SubStepStatus::Solved { .. }),
-            "{:?}",
-            r.status
-        );
-        // It uses the whole sideways range to reduce the violation: sigma moves y by -0.01.
-        assert!((r.du[0].0 + 1.0).abs() < 1e-6, "{:?}", r.du);
+        for r in by_each_solver(&sub(&j, &p, &w, &ranges)) {
+            assert!(
+                matches!(r.status, SubStepStatus::Solved { .. }),
+                "{:?}",
+                r.status
+            );
+            // It uses the whole sideways range to reduce the violation: sigma moves y by -0.01.
+            assert!((r.du[0].0 + 1.0).abs() < 1e-6, "{:?}", r.du);
+        }
+    }
+
+    /// A deterministic stream of numbers in [0, 1) (a linear congruential generator).
+    struct Stream(u64);
+
+    impl Stream {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        fn within(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + (hi - lo) * self.next()
+        }
+    }
+
+    /// Owned data of a random chain sub-problem shaped as the SCP makes them: frames that carry the
+    /// state over with small couplings, wall rows on a move's two ends sharing the move's slack, some
+    /// controls fixed, and curvature blocks `M M'`.
+    struct RandomChain {
+        jacobians: Vec<FrameJacobian>,
+        positions: Vec<Vec2>,
+        walls: Vec<WallRow>,
+        sigma_range: Vec<(f64, f64)>,
+        c_range: Vec<(f64, f64)>,
+        curvature: Option<Vec<CurvatureBlock>>,
+    }
+
+    fn random_chain(s: &mut Stream) -> RandomChain {
+        let n = 1 + (s.next() * 60.0) as usize;
+        let mut chain = RandomChain {
+            jacobians: vec![],
+            positions: vec![],
+            walls: vec![],
+            sigma_range: vec![],
+            c_range: vec![],
+            curvature: None,
+        };
+        let mut y = 0.0;
+        for k in 0..n {
+            let mut a = [[0.0; 4]; 4];
+            for (i, row) in a.iter_mut().enumerate() {
+                for (j, x) in row.iter_mut().enumerate() {
+                    *x = if i == j { 1.0 } else { s.within(-0.1, 0.1) };
+                }
+            }
+            let b = std::array::from_fn(|_| [s.within(-1.0, 1.0), s.within(-0.1, 0.1)]);
+            chain.jacobians.push(FrameJacobian { a, b });
+            y += s.within(-1.0, 1.0);
+            chain.positions.push(Vec2::new(k as f64, y));
+            let range = |s: &mut Stream| {
+                if s.next() < 0.2 {
+                    (0.0, 0.0)
+                } else {
+                    (s.within(0.0, 0.5), s.within(0.0, 0.5))
+                }
+            };
+            chain.sigma_range.push(range(s));
+            let (lo, hi) = range(s);
+            chain.c_range.push((10.0 * lo, 10.0 * hi));
+            // Walls above and below the line, leaning either way: some rows violated (paid with
+            // slack), some binding.
+            for normal_y in [-1.0, 1.0] {
+                if s.next() < 0.5 {
+                    let normal = Vec2::new(s.within(-0.5, 0.5), normal_y);
+                    let normal = normal * (1.0 / normal.length());
+                    let plane = HalfPlane {
+                        normal,
+                        offset: normal.dot(Vec2::new(k as f64, y)) - s.within(-0.5, 3.0),
+                    };
+                    chain.walls.push(WallRow {
+                        frame: k,
+                        plane,
+                        group: k,
+                    });
+                    if k > 0 {
+                        chain.walls.push(WallRow {
+                            frame: k - 1,
+                            plane,
+                            group: k,
+                        });
+                    }
+                }
+            }
+        }
+        if s.next() < 0.7 {
+            let blocks = (0..n)
+                .map(|_| {
+                    let m: [[f64; 4]; 4] =
+                        std::array::from_fn(|_| std::array::from_fn(|_| s.within(-1.0, 1.0)));
+                    std::array::from_fn(|i| {
+                        std::array::from_fn(|j| (0..4).map(|l| m[i][l] * m[j][l]).sum::<f64>())
+                    })
+                })
+                .collect();
+            chain.curvature = Some(blocks);
+        }
+        chain
+    }
+
+    #[test]
+    fn both_solvers_find_the_same_step_on_random_chains_of_frames() {
+        // The same convex QP: the optimum's value is unique, and with strictly convex curvature so are
+        // its steps and duals. Either solver wrong (a row mis-signed, a frame's dynamics or curvature
+        // misplaced, the duals' convention) moves the predicted gain or the duals apart.
+        let mut s = Stream(20261128);
+        let mut compared = 0;
+        for case in 0..60 {
+            let c = random_chain(&mut s);
+            let sp = SubProblem {
+                jacobians: &c.jacobians,
+                positions: &c.positions,
+                walls: &c.walls,
+                margin: 0.0,
+                accepted_clearance: 0.0,
+                slack_weight: 100.0,
+                progress_dir: Vec2::new(0.8, 0.6),
+                sigma_range: &c.sigma_range,
+                c_range: &c.c_range,
+                curvature: c.curvature.as_deref(),
+                wall_shift: None,
+                solver: SubProblemSolver::Riccati,
+            };
+            let layout = Layout::of(&sp);
+            let rhs = wall_rhs(&sp);
+            let staged =
+                stagewise::solve(&layout.staged(&sp, &rhs), MAX_SUBPROBLEM_ITERATIONS, 10.0);
+            assert!(staged.is_ok(), "case {case}: {:?}", staged.err());
+            let [riccati, clarabel] = by_each_solver(&sp);
+            assert_eq!(
+                clarabel.status,
+                SubStepStatus::Solved { almost: false },
+                "case {case}"
+            );
+            assert_eq!(
+                riccati.status,
+                SubStepStatus::Solved { almost: false },
+                "case {case}"
+            );
+            let scale = 1.0 + clarabel.predicted.abs();
+            assert!(
+                (riccati.predicted - clarabel.predicted).abs() < 1e-4 * scale,
+                "case {case}: predicted {} against {}",
+                riccati.predicted,
+                clarabel.predicted
+            );
+            if c.curvature.is_some() {
+                let largest = clarabel
+                    .dynamics_duals
+                    .iter()
+                    .flatten()
+                    .fold(1.0_f64, |m, z| m.max(z.abs()));
+                for (k, (zr, zc)) in riccati
+                    .dynamics_duals
+                    .iter()
+                    .zip(&clarabel.dynamics_duals)
+                    .enumerate()
+                {
+                    for i in 0..4 {
+                        assert!(
+                            (zr[i] - zc[i]).abs() < 1e-3 * largest,
+                            "case {case}, frame {k}, dual {i}: {} against {}",
+                            zr[i],
+                            zc[i]
+                        );
+                    }
+                }
+                compared += 1;
+            }
+        }
+        assert!(compared >= 30, "only {compared} cases had curvature");
     }
 }

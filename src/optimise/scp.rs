@@ -16,7 +16,7 @@
 
 use super::lagrangian::{convexify, lagrangian_block, CurvatureBlock};
 use super::model::{knot, knot_hessian, rollout_knots, FrameControl, FrameLaw, ModelState};
-use super::qp::{self, SubProblem, SubStepStatus, WallRow};
+use super::qp::{self, SubProblem, SubProblemSolver, SubStepStatus, WallRow};
 use super::search::SearchStats;
 use crate::budget::Budget;
 use crate::geometry::{Corridor, Separation};
@@ -49,6 +49,8 @@ pub struct ScpProblem<'a> {
     /// ([`FrameLaw::c_exact_max`]); else `c` keeps under the guard as in the relaxed problem. With
     /// `anglemod_guard` too, each frame keeps to its side of the guard's band ([`FrameLaw::guard_band`]).
     pub(super) turn_less: bool,
+    /// The solver its sub-problems are given first.
+    pub(super) sub_problem_solver: SubProblemSolver,
 }
 
 /// One iteration's linearisation with the trust region's ranges: everything its sub-problems need.
@@ -259,6 +261,7 @@ impl ScpProblem<'_> {
             c_range: &lz.c_range,
             curvature: lz.lin.curvature.as_deref(),
             wall_shift,
+            solver: self.sub_problem_solver,
         }
     }
 

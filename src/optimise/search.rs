@@ -17,6 +17,7 @@ use super::airborne::plan_airborne;
 use super::baseline::{baseline, corner_caps, given_up_frame, GreedyGuide, GuideRun};
 use super::bound::{frame_limited_scene, lower_bound_within};
 use super::planner::Planner;
+use super::qp::SubProblemSolver;
 use super::relaxed::RelaxedCertificate;
 use super::verify::time_of;
 use super::LowerBound;
@@ -67,6 +68,8 @@ pub struct SearchSettings {
     /// Most frames a run is planned over: a scene whose lower bound needs more is refused
     /// ([`Error::FrameLimit`]), and no simulated run goes further (the scene's own cap, if lower, holds).
     pub max_frames: u64,
+    /// The solver each convexified sub-step is given first.
+    pub sub_problem_solver: SubProblemSolver,
 }
 
 impl SearchSettings {
@@ -84,6 +87,7 @@ impl SearchSettings {
             certificate_starts: 3,
             time_limit: None,
             max_frames: crate::budget::DEFAULT_MAX_PLANNED_FRAMES,
+            sub_problem_solver: SubProblemSolver::default(),
         };
         match quality {
             Quality::Fast => SearchSettings {
@@ -327,15 +331,7 @@ fn solve_within(
     if !scene.effects.is_air_only() {
         return solve_once(scene, settings, budget, progress);
     }
-    let mut runs: Vec<SearchSettings> = levels_below(settings.quality)
-        .iter()
-        .map(|&quality| SearchSettings {
-            time_limit: settings.time_limit,
-            max_frames: settings.max_frames,
-            ..SearchSettings::for_quality(quality)
-        })
-        .collect();
-    runs.push(*settings);
+    let mut runs = level_runs(settings);
     // Never empty: it ends with the requested level.
     let first = runs.remove(0);
     let mut best = solve_once(scene, &first, budget, progress)?;
@@ -371,6 +367,22 @@ fn solve_within(
     best.stats = stats;
     best.solve_seconds = started.elapsed().as_secs_f64();
     Ok(best)
+}
+
+/// The settings of each level an airborne solve at `settings` runs, cheapest first: the cheaper levels'
+/// own settings with the caller's time limit, frame limit and sub-problem solver, then `settings`.
+fn level_runs(settings: &SearchSettings) -> Vec<SearchSettings> {
+    let mut runs: Vec<SearchSettings> = levels_below(settings.quality)
+        .iter()
+        .map(|&quality| SearchSettings {
+            time_limit: settings.time_limit,
+            max_frames: settings.max_frames,
+            sub_problem_solver: settings.sub_problem_solver,
+            ..SearchSettings::for_quality(quality)
+        })
+        .collect();
+    runs.push(*settings);
+    runs
 }
 
 /// The levels an airborne solve at `quality` runs before it, cheapest first: each has a valid plan
@@ -576,6 +588,29 @@ pub fn time_limit(seconds: f64) -> Result<Duration> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_level_an_exact_solve_runs_keeps_the_callers_limits_and_sub_problem_solver() {
+        let settings = SearchSettings {
+            time_limit: Some(Duration::from_secs(7)),
+            max_frames: 1234,
+            sub_problem_solver: SubProblemSolver::Clarabel,
+            ..SearchSettings::for_quality(Quality::Exact)
+        };
+        let runs = level_runs(&settings);
+        let levels: Vec<Quality> = runs.iter().map(|r| r.quality).collect();
+        assert_eq!(levels, [Quality::Fast, Quality::Balanced, Quality::Exact]);
+        for run in &runs {
+            assert_eq!(run.time_limit, settings.time_limit);
+            assert_eq!(run.max_frames, 1234);
+            assert_eq!(run.sub_problem_solver, SubProblemSolver::Clarabel);
+        }
+        // The cheaper levels keep their own iterations.
+        assert_eq!(
+            runs[0].relaxed_iters,
+            SearchSettings::for_quality(Quality::Fast).relaxed_iters
+        );
+    }
 
     #[test]
     fn time_limits_out_of_range_are_errors_not_panics() {

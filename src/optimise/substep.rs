@@ -4,7 +4,7 @@
 //! [`super::search`] without running the search.
 
 use super::model::{frame, frame_control_of, FrameControl, FrameJacobian, FrameLaw, ModelState};
-use super::qp::{self, SubProblem, SubStep, WallRow};
+use super::qp::{self, SubProblem, SubProblemSolver, SubStep, WallRow};
 use super::{lower_bound, SearchSettings};
 use crate::error::{Error, Result};
 use crate::geometry::Separation;
@@ -37,6 +37,8 @@ pub struct SubStepSetup {
     pub margin: f64,
     /// Slack weight.
     pub slack_weight: f64,
+    /// The solver the sub-problem is given first.
+    pub solver: SubProblemSolver,
 }
 
 impl SubStepSetup {
@@ -120,6 +122,7 @@ impl SubStepSetup {
             progress_dir: if n.dot(approach) >= 0.0 { n } else { -n },
             margin,
             slack_weight: settings.slack_weight,
+            solver: settings.sub_problem_solver,
         })
     }
 
@@ -137,10 +140,11 @@ impl SubStepSetup {
             c_range: &self.c_range,
             curvature: None,
             wall_shift: None,
+            solver: self.solver,
         }
     }
 
-    /// Solves the sub-problem with Clarabel.
+    /// Solves the sub-problem.
     pub fn solve(&self) -> SubStep {
         qp::solve(&self.sub_problem())
     }

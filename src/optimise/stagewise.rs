@@ -1,0 +1,908 @@
+//! The convexified sub-step solved frame by frame: a primal-dual interior-point method (Mehrotra's
+//! predictor-corrector) whose Newton systems are solved by a Riccati recursion over the frames.
+//!
+//! The sub-problem of [`super::qp`] is an optimal-control problem: the state change `dx_k` of frame `k`
+//! follows from the one before and the frame's own variables `v_k` (its free control changes and the
+//! slack of the move ending at frame `k`) through `dx_k = A_k dx_{k-1} + B_k v_k`; every inequality row
+//! touches one frame's `(dx_{k-1}, v_k)` (a wall row on `dx_k` is written through the dynamics); the
+//! curvature couples `dx_{k-1}` and `v_k` only; progress is linear in the last state. A general sparse
+//! factorisation of its KKT system (Clarabel's) does not use that chain; the recursion needs per frame a
+//! handful of 4x4 products and the Cholesky factor of a matrix at most 3x3, and solves a sub-problem
+//! three to five times faster than Clarabel (docs/design.md, "The sub-problem solved frame by frame").
+//!
+//! Per interior-point iteration: the inequality rows `G z + t = h` with slacks `t >= 0` and duals
+//! `lambda >= 0` are eliminated (weights `lambda / t`), which leaves an equality-constrained QP in the
+//! frames' variables; its backward Riccati pass gives the feedback `v_k = K_k dx_{k-1} + k_k`, its
+//! forward pass the step. The start is strictly feasible (controls at the centre of their boxes, slacks
+//! above every row's violation), so the rows stay met and only complementarity and stationarity are
+//! driven to zero.
+
+use super::lagrangian::CurvatureBlock;
+use super::model::FrameJacobian;
+use super::qp::{
+    WallRow, CONTROL_REGULARISATION, C_SCALE_UPS, SUBPROBLEM_FEAS_TOL, SUBPROBLEM_GAP_TOL,
+};
+
+/// Most variables a frame has: its two controls and one slack.
+const MAX_FRAME_VARS: usize = 3;
+
+/// The sub-problem laid out as [`super::qp`] lays it out for Clarabel (the same variables, indexed the
+/// same way), so that a solution of either solver is read by the same code.
+pub(super) struct StagedProblem<'a> {
+    /// Per frame, the Jacobian of the frame.
+    pub jacobians: &'a [FrameJacobian],
+    /// Variable of control `j` of frame `k` at `2 k + j`; `None`: fixed.
+    pub control_var: &'a [Option<usize>],
+    /// Number of control variables (they come first).
+    pub n_controls: usize,
+    /// Per frame, the allowed change `[-lo, hi]` of its two controls, scaled (`c` by [`C_SCALE_UPS`]).
+    pub control_ranges: &'a [[(f64, f64); 2]],
+    /// Wall rows, their right-hand sides (`-n . dp - s <= rhs`) and the slack each shares.
+    pub walls: &'a [WallRow],
+    /// Per wall row, its right-hand side, units.
+    pub wall_rhs: &'a [f64],
+    /// Per wall row, the index of its slack among the slacks.
+    pub row_slack: &'a [usize],
+    /// Number of slacks (they come after the controls and the `4 n` state changes).
+    pub n_slacks: usize,
+    /// Weight of a unit of slack.
+    pub slack_weight: f64,
+    /// Gradient of the objective in the last state change (minus the progress direction).
+    pub terminal_gradient: [f64; 4],
+    /// Per frame, the curvature block in `(V_{k-1}, psi_{k-1}, sigma_k, c_k)`, if any.
+    pub curvature: Option<&'a [CurvatureBlock]>,
+}
+
+/// A solution in Clarabel's layout: the primal `x` and, per frame, the duals of its dynamics rows in
+/// Clarabel's convention (`P x + q + A' z = 0`).
+pub(super) struct StagedSolution {
+    /// All variables, laid out as in [`StagedProblem`].
+    pub x: Vec<f64>,
+    /// Per frame, the duals of its dynamics rows `(px, py, V, psi)`.
+    pub dynamics_duals: Vec<[f64; 4]>,
+    /// Met only the looser tolerances.
+    pub almost: bool,
+}
+
+/// Why the frame-by-frame solver gave no solution (the caller then asks Clarabel).
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum NotStaged {
+    /// A slack is shared by rows more than one frame apart, or two slacks end at one frame: the rows
+    /// are not a chain of frames.
+    NotAChain,
+    /// A frame's reduced Hessian was not positive definite, or a value not finite. Where an active wall
+    /// row meets an active bound their weights (`lambda / t`, near 1e12) make the Riccati pass subtract
+    /// numbers of that size, and the value matrix can lose its digits.
+    Numerics,
+    /// The iteration cap came before the tolerances.
+    MaxIterations,
+    /// The time limit came first.
+    TimeLimit,
+}
+
+/// What a frame's variable is.
+#[derive(Clone, Copy, Debug)]
+enum FrameVar {
+    /// Control `j` (0: side, 1: `c`) at variable `var` of the layout.
+    Control { j: usize, var: usize },
+    /// Slack `slack`.
+    Slack { slack: usize },
+}
+
+/// One inequality row of a frame: `c . dx_{k-1} + d . v_k <= h`.
+#[derive(Clone, Copy, Debug)]
+struct Row {
+    c: [f64; 4],
+    d: [f64; MAX_FRAME_VARS],
+    h: f64,
+    /// A bound on one variable (`c = 0`, one entry of `d`): its index in `v`. Its weight in the Newton
+    /// system falls on the diagonal only.
+    bound: Option<usize>,
+}
+
+impl Row {
+    /// `sign v[at] <= h`.
+    fn bound(at: usize, sign: f64, h: f64) -> Row {
+        let mut d = [0.0; MAX_FRAME_VARS];
+        d[at] = sign;
+        Row {
+            c: [0.0; 4],
+            d,
+            h,
+            bound: Some(at),
+        }
+    }
+
+    /// `g += weight (c, d)`: the row's pull on a frame's gradient at dual `weight`.
+    fn add_to(&self, g: &mut [f64; 4 + MAX_FRAME_VARS], weight: f64) {
+        for (gi, a) in g.iter_mut().zip(self.c.iter().chain(&self.d)) {
+            *gi += a * weight;
+        }
+    }
+}
+
+/// A frame of the chain: its variables, its rows, its cost `0.5 z' H z + g' z` in
+/// `z = (dx_{k-1}, v_k)` and its dynamics `dx_k = A dx_{k-1} + B v_k`.
+struct Frame {
+    vars: Vec<FrameVar>,
+    /// Per variable, where the start puts it: a control at the centre of its box.
+    centre: [f64; MAX_FRAME_VARS],
+    rows: Vec<Row>,
+    hessian: [[f64; 4 + MAX_FRAME_VARS]; 4 + MAX_FRAME_VARS],
+    gradient: [f64; 4 + MAX_FRAME_VARS],
+    a: [[f64; 4]; 4],
+    b: [[f64; MAX_FRAME_VARS]; 4],
+}
+
+impl Frame {
+    fn nv(&self) -> usize {
+        self.vars.len()
+    }
+
+    /// `A dx + B v`.
+    fn step(&self, dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> [f64; 4] {
+        std::array::from_fn(|i| {
+            (0..4).map(|j| self.a[i][j] * dx[j]).sum::<f64>()
+                + (0..self.nv()).map(|j| self.b[i][j] * v[j]).sum::<f64>()
+        })
+    }
+
+    /// `c . dx + d . v` of a row.
+    fn row_value(&self, row: &Row, dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> f64 {
+        (0..4).map(|i| row.c[i] * dx[i]).sum::<f64>()
+            + (0..self.nv()).map(|j| row.d[j] * v[j]).sum::<f64>()
+    }
+
+    /// `H z + g` at `z = (dx, v)`.
+    fn cost_gradient(&self, dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> [f64; 4 + MAX_FRAME_VARS] {
+        let z = joined(dx, v);
+        let n = 4 + self.nv();
+        std::array::from_fn(|i| {
+            if i < n {
+                self.gradient[i] + (0..n).map(|j| self.hessian[i][j] * z[j]).sum::<f64>()
+            } else {
+                0.0
+            }
+        })
+    }
+}
+
+fn joined(dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> [f64; 4 + MAX_FRAME_VARS] {
+    std::array::from_fn(|i| if i < 4 { dx[i] } else { v[i - 4] })
+}
+
+/// Where a row sits: its frame, and its index among the frame's rows.
+type RowAt = (usize, usize);
+
+/// The frames of `p` and, per wall row, its frame and its index among the frame's rows; or
+/// [`NotStaged::NotAChain`].
+fn frames_of(p: &StagedProblem) -> Result<(Vec<Frame>, Vec<RowAt>), NotStaged> {
+    let n = p.jacobians.len();
+    // Each slack belongs to the last frame of its rows; its rows must be at that frame or the one before.
+    let mut slack_frame = vec![0usize; p.n_slacks];
+    for (w, &s) in p.walls.iter().zip(p.row_slack) {
+        slack_frame[s] = slack_frame[s].max(w.frame);
+    }
+    let mut slack_of_frame: Vec<Option<usize>> = vec![None; n];
+    for (s, &k) in slack_frame.iter().enumerate() {
+        if k >= n || slack_of_frame[k].replace(s).is_some() {
+            return Err(NotStaged::NotAChain);
+        }
+    }
+    let mut frames: Vec<Frame> = (0..n)
+        .map(|k| frame_without_walls(p, k, slack_of_frame[k]))
+        .collect();
+    let mut wall_rows = Vec::with_capacity(p.walls.len());
+    for ((w, &rhs), &s) in p.walls.iter().zip(p.wall_rhs).zip(p.row_slack) {
+        let k = slack_frame[s];
+        if w.frame + 1 < k {
+            return Err(NotStaged::NotAChain);
+        }
+        let frame = &mut frames[k];
+        let slack_at = frame.nv() - 1;
+        let (nx, ny) = (w.plane.normal.x, w.plane.normal.y);
+        let mut row = Row {
+            c: [0.0; 4],
+            d: [0.0; MAX_FRAME_VARS],
+            h: rhs,
+            bound: None,
+        };
+        if w.frame == k {
+            // -n . (A dx + B v): the wall row of the frame's own end, through its dynamics.
+            row.c = std::array::from_fn(|j| -(nx * frame.a[0][j] + ny * frame.a[1][j]));
+            for j in 0..frame.nv() {
+                row.d[j] = -(nx * frame.b[0][j] + ny * frame.b[1][j]);
+            }
+        } else {
+            row.c = [-nx, -ny, 0.0, 0.0];
+        }
+        row.d[slack_at] -= 1.0;
+        wall_rows.push((k, frame.rows.len()));
+        frame.rows.push(row);
+    }
+    Ok((frames, wall_rows))
+}
+
+/// Frame `k` with its variables (free controls, then its slack if any), the rows of its controls'
+/// boxes and its slack's sign, and its cost.
+fn frame_without_walls(p: &StagedProblem, k: usize, slack: Option<usize>) -> Frame {
+    let jac = &p.jacobians[k];
+    let mut vars: Vec<FrameVar> = (0..2)
+        .filter_map(|j| p.control_var[2 * k + j].map(|var| FrameVar::Control { j, var }))
+        .collect();
+    vars.extend(slack.map(|slack| FrameVar::Slack { slack }));
+    // The first frame starts from no change: its incoming state carries nothing.
+    let a = if k > 0 { jac.a } else { [[0.0; 4]; 4] };
+    let mut b = [[0.0; MAX_FRAME_VARS]; 4];
+    let mut rows = Vec::new();
+    let mut hessian = [[0.0; 4 + MAX_FRAME_VARS]; 4 + MAX_FRAME_VARS];
+    let mut gradient = [0.0; 4 + MAX_FRAME_VARS];
+    let mut centre = [0.0; MAX_FRAME_VARS];
+    for (at, var) in vars.iter().enumerate() {
+        match *var {
+            FrameVar::Control { j, .. } => {
+                let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
+                for (bi, ji) in b.iter_mut().zip(&jac.b) {
+                    bi[at] = ji[j] * scale;
+                }
+                let (lo, hi) = p.control_ranges[k][j];
+                centre[at] = 0.5 * (hi - lo);
+                rows.push(Row::bound(at, 1.0, hi));
+                rows.push(Row::bound(at, -1.0, lo));
+                hessian[4 + at][4 + at] += CONTROL_REGULARISATION;
+            }
+            FrameVar::Slack { .. } => {
+                rows.push(Row::bound(at, -1.0, 0.0));
+                gradient[4 + at] = p.slack_weight;
+            }
+        }
+    }
+    if let Some(block) = p.curvature.and_then(|c| c.get(k)) {
+        // The block's inputs (V_{k-1}, psi_{k-1}, sigma_k, c_k) as positions in z, with their scales.
+        let control_at = |j: usize| {
+            vars.iter()
+                .position(|v| matches!(v, FrameVar::Control { j: vj, .. } if *vj == j))
+        };
+        let at: [Option<(usize, f64)>; 4] = [
+            (k > 0).then_some((2, 1.0)),
+            (k > 0).then_some((3, 1.0)),
+            control_at(0).map(|i| (4 + i, 1.0)),
+            control_at(1).map(|i| (4 + i, C_SCALE_UPS)),
+        ];
+        for (i, ai) in at.iter().enumerate() {
+            for (j, aj) in at.iter().enumerate() {
+                if let (Some((r, sr)), Some((c, sc))) = (ai, aj) {
+                    hessian[*r][*c] += block[i][j] * sr * sc;
+                }
+            }
+        }
+    }
+    Frame {
+        vars,
+        centre,
+        rows,
+        hessian,
+        gradient,
+        a,
+        b,
+    }
+}
+
+/// The tolerances loosened by this much: a solution that meets only these at the iteration cap is
+/// "almost" solved (as Clarabel's `AlmostSolved`).
+const ALMOST_FACTOR: f64 = 1e3;
+/// Share of the way to the boundary that a step goes.
+const STEP_TO_BOUNDARY: f64 = 0.99;
+
+/// The iterate: per frame its variables and the state change after it, per row its slack and dual.
+struct Iterate {
+    v: Vec<[f64; MAX_FRAME_VARS]>,
+    dx: Vec<[f64; 4]>,
+    t: Vec<f64>,
+    lambda: Vec<f64>,
+    /// Per row, `G z + t - h`; a step of length `alpha` scales it by `1 - alpha` (the rows are linear).
+    rp: Vec<f64>,
+}
+
+/// A frame's part of the Newton system's factorisation.
+#[derive(Clone, Copy, Default)]
+struct FrameFactor {
+    /// Lower Cholesky factor of the reduced Hessian in the frame's variables.
+    chol: [[f64; MAX_FRAME_VARS]; MAX_FRAME_VARS],
+    /// Cross term `Q_vx`.
+    q_vx: [[f64; 4]; MAX_FRAME_VARS],
+    /// Feedback `K = -Q_vv^-1 Q_vx`.
+    gain: [[f64; 4]; MAX_FRAME_VARS],
+}
+
+/// A Newton direction.
+struct Direction {
+    dv: Vec<[f64; MAX_FRAME_VARS]>,
+    dt: Vec<f64>,
+    dlambda: Vec<f64>,
+}
+
+/// Solves `p` within `max_iterations` interior-point iterations and `time_limit_s` seconds.
+///
+/// Solved means: complementarity summed over the rows within the gap tolerance, stationarity within the
+/// feasibility tolerance relative to the objective's largest gradient entry, and every row met within it
+/// relative to the largest right-hand side (the tolerances of [`super::qp`]). The gap is absolute: the
+/// objective carries the weighted violation the trust region cannot remove (thousands of units where a
+/// start is far inside a wall), and a gap relative to it left a control 5e-4 short of its bound.
+pub(super) fn solve(
+    p: &StagedProblem,
+    max_iterations: u32,
+    time_limit_s: f64,
+) -> Result<StagedSolution, NotStaged> {
+    let clock = std::time::Instant::now();
+    let (frames, wall_rows) = frames_of(p)?;
+    let offsets: Vec<usize> = frames
+        .iter()
+        .scan(0, |at, f| {
+            let o = *at;
+            *at += f.rows.len();
+            Some(o)
+        })
+        .collect();
+    let mut it = started(p, &frames, &offsets)?;
+    let tolerances = Tolerances::of(p, &frames);
+    let mut almost = false;
+    for _ in 0..max_iterations {
+        if clock.elapsed().as_secs_f64() > time_limit_s {
+            return Err(NotStaged::TimeLimit);
+        }
+        match tolerances.met(p, &frames, &offsets, &it) {
+            Met::Solved => return Ok(solution(p, &frames, &wall_rows, &offsets, &it, false)),
+            Met::Almost => almost = true,
+            Met::Not => almost = false,
+        }
+        mehrotra_step(p, &frames, &offsets, &mut it)?;
+    }
+    if almost {
+        return Ok(solution(p, &frames, &wall_rows, &offsets, &it, true));
+    }
+    Err(NotStaged::MaxIterations)
+}
+
+/// The tolerances of a solution, scaled to the problem's data.
+struct Tolerances {
+    gap: f64,
+    stationarity: f64,
+    feasibility: f64,
+}
+
+/// Which tolerances an iterate meets.
+enum Met {
+    Solved,
+    Almost,
+    Not,
+}
+
+impl Tolerances {
+    fn of(p: &StagedProblem, frames: &[Frame]) -> Tolerances {
+        let rhs_scale = frames
+            .iter()
+            .flat_map(|f| f.rows.iter())
+            .fold(1.0_f64, |m, r| m.max(r.h.abs()));
+        Tolerances {
+            gap: SUBPROBLEM_GAP_TOL,
+            stationarity: SUBPROBLEM_FEAS_TOL * gradient_scale(p, frames),
+            feasibility: SUBPROBLEM_FEAS_TOL * rhs_scale,
+        }
+    }
+
+    /// Whether `it` meets the tolerances, or the looser ones of "almost". Stationarity and the rows'
+    /// residuals (a pass over the frames each) are measured only once the gap is within reach.
+    fn met(&self, p: &StagedProblem, frames: &[Frame], offsets: &[usize], it: &Iterate) -> Met {
+        let gap: f64 = it.t.iter().zip(&it.lambda).map(|(t, l)| t * l).sum();
+        if gap > ALMOST_FACTOR * self.gap {
+            return Met::Not;
+        }
+        let stationarity = stationarity(p, frames, offsets, it);
+        let infeasibility = primal_residual(frames, offsets, it)
+            .iter()
+            .fold(0.0_f64, |m, r| m.max(r.abs()));
+        let within = |factor: f64| {
+            gap <= factor * self.gap
+                && stationarity <= factor * self.stationarity
+                && infeasibility <= factor * self.feasibility
+        };
+        if within(1.0) {
+            Met::Solved
+        } else if within(ALMOST_FACTOR) {
+            Met::Almost
+        } else {
+            Met::Not
+        }
+    }
+}
+
+/// One predictor-corrector step (Mehrotra's): the affine direction drives complementarity to zero; how
+/// far it gets sets the centring `sigma = (mu_aff / mu)^3`; the corrector adds the affine step's
+/// second-order term and the centring. Both directions share one factorisation.
+fn mehrotra_step(
+    p: &StagedProblem,
+    frames: &[Frame],
+    offsets: &[usize],
+    it: &mut Iterate,
+) -> Result<(), NotStaged> {
+    let m = it.t.len().max(1) as f64;
+    let factors = factorised(frames, offsets, it)?;
+    let rc_aff: Vec<f64> = it.t.iter().zip(&it.lambda).map(|(t, l)| t * l).collect();
+    let aff = direction(p, frames, offsets, &factors, it, &rc_aff)?;
+    let alpha_aff = step_to_boundary(it, &aff, 1.0);
+    let mu = rc_aff.iter().sum::<f64>() / m;
+    let mu_aff = (0..it.t.len())
+        .map(|i| (it.t[i] + alpha_aff * aff.dt[i]) * (it.lambda[i] + alpha_aff * aff.dlambda[i]))
+        .sum::<f64>()
+        / m;
+    let sigma = (mu_aff / mu).clamp(0.0, 1.0).powi(3);
+    let rc: Vec<f64> = (0..it.t.len())
+        .map(|i| rc_aff[i] + aff.dt[i] * aff.dlambda[i] - sigma * mu)
+        .collect();
+    let dir = direction(p, frames, offsets, &factors, it, &rc)?;
+    let alpha = step_to_boundary(it, &dir, STEP_TO_BOUNDARY);
+    take_step(frames, it, &dir, alpha);
+    if it.v.iter().flatten().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(NotStaged::Numerics)
+    }
+}
+
+/// The first iterate (Mehrotra's, as in Nocedal and Wright, section 16.6): from controls at the centre
+/// of their boxes, slacks one unit above their rows' worst violation and every row's slack and dual at
+/// one, one affine step; then each row's slack and dual is the size that step gives it, at least one.
+fn started(p: &StagedProblem, frames: &[Frame], offsets: &[usize]) -> Result<Iterate, NotStaged> {
+    let mut it = centred(frames);
+    it.rp = primal_residual(frames, offsets, &it);
+    let factors = factorised(frames, offsets, &it)?;
+    let rc: Vec<f64> = it.t.iter().zip(&it.lambda).map(|(t, l)| t * l).collect();
+    let aff = direction(p, frames, offsets, &factors, &it, &rc)?;
+    for (t, dt) in it.t.iter_mut().zip(&aff.dt) {
+        *t = (*t + dt).abs().max(1.0);
+    }
+    for (l, dl) in it.lambda.iter_mut().zip(&aff.dlambda) {
+        *l = (*l + dl).abs().max(1.0);
+    }
+    it.rp = primal_residual(frames, offsets, &it);
+    Ok(it)
+}
+
+/// Per row, `G z + t - h`.
+fn primal_residual(frames: &[Frame], offsets: &[usize], it: &Iterate) -> Vec<f64> {
+    let mut rp = vec![0.0; it.t.len()];
+    for (k, f) in frames.iter().enumerate() {
+        let xb = before(it, k);
+        for (r, row) in f.rows.iter().enumerate() {
+            let i = offsets[k] + r;
+            rp[i] = f.row_value(row, &xb, &it.v[k]) + it.t[i] - row.h;
+        }
+    }
+    rp
+}
+
+/// Controls at the centre of their boxes, each slack one unit above its rows' worst violation, every
+/// row's slack and dual at one.
+fn centred(frames: &[Frame]) -> Iterate {
+    let mut v = Vec::with_capacity(frames.len());
+    let mut dx = Vec::with_capacity(frames.len());
+    let mut t = Vec::new();
+    let mut before = [0.0; 4];
+    for f in frames {
+        let mut vk = f.centre;
+        let worst = f
+            .rows
+            .iter()
+            .map(|r| f.row_value(r, &before, &vk) - r.h)
+            .fold(0.0_f64, f64::max);
+        if let Some(at) = f
+            .vars
+            .iter()
+            .position(|v| matches!(v, FrameVar::Slack { .. }))
+        {
+            vk[at] = worst + 1.0;
+        }
+        t.extend(f.rows.iter().map(|_| 1.0));
+        let after = f.step(&before, &vk);
+        v.push(vk);
+        dx.push(after);
+        before = after;
+    }
+    let lambda = vec![1.0; t.len()];
+    let rp = vec![0.0; t.len()];
+    Iterate {
+        v,
+        dx,
+        t,
+        lambda,
+        rp,
+    }
+}
+
+/// The largest entry of the objective's and the rows' data: the scale of stationarity.
+fn gradient_scale(p: &StagedProblem, frames: &[Frame]) -> f64 {
+    let terminal = p
+        .terminal_gradient
+        .iter()
+        .fold(0.0_f64, |m, g| m.max(g.abs()));
+    frames
+        .iter()
+        .flat_map(|f| f.gradient.iter())
+        .fold(terminal.max(1.0), |m, g| m.max(g.abs()))
+}
+
+/// The state change before frame `k` (none before the first).
+fn before(it: &Iterate, k: usize) -> [f64; 4] {
+    if k == 0 {
+        [0.0; 4]
+    } else {
+        it.dx[k - 1]
+    }
+}
+
+/// The largest entry of the reduced gradient of the Lagrangian: stationarity in the frames' variables,
+/// the states eliminated through the dynamics.
+fn stationarity(p: &StagedProblem, frames: &[Frame], offsets: &[usize], it: &Iterate) -> f64 {
+    let mut adjoint = p.terminal_gradient;
+    let mut largest = 0.0_f64;
+    for (k, f) in frames.iter().enumerate().rev() {
+        let mut grad = f.cost_gradient(&before(it, k), &it.v[k]);
+        for (r, row) in f.rows.iter().enumerate() {
+            row.add_to(&mut grad, it.lambda[offsets[k] + r]);
+        }
+        for j in 0..f.nv() {
+            let r = grad[4 + j] + (0..4).map(|i| f.b[i][j] * adjoint[i]).sum::<f64>();
+            largest = largest.max(r.abs());
+        }
+        adjoint =
+            std::array::from_fn(|j| grad[j] + (0..4).map(|i| f.a[i][j] * adjoint[i]).sum::<f64>());
+    }
+    largest
+}
+
+/// The backward Riccati pass over the frames with the rows eliminated at weights `lambda / t`: per
+/// frame the factor of its reduced Hessian, its cross term and its feedback gain.
+fn factorised(
+    frames: &[Frame],
+    offsets: &[usize],
+    it: &Iterate,
+) -> Result<Vec<FrameFactor>, NotStaged> {
+    let mut factors = vec![FrameFactor::default(); frames.len()];
+    let mut value = [[0.0; 4]; 4];
+    for (k, f) in frames.iter().enumerate().rev() {
+        let nv = f.nv();
+        let n = 4 + nv;
+        let mut h = f.hessian;
+        for (r, row) in f.rows.iter().enumerate() {
+            let w = it.lambda[offsets[k] + r] / it.t[offsets[k] + r];
+            if let Some(at) = row.bound {
+                h[4 + at][4 + at] += w;
+                continue;
+            }
+            let z = joined(&row.c, &row.d);
+            for i in 0..n {
+                for j in 0..n {
+                    h[i][j] += w * z[i] * z[j];
+                }
+            }
+        }
+        // P A and P B.
+        let pa: [[f64; 4]; 4] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..4).map(|l| value[i][l] * f.a[l][j]).sum())
+        });
+        let pb: [[f64; MAX_FRAME_VARS]; 4] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..4).map(|l| value[i][l] * f.b[l][j]).sum())
+        });
+        let q_xx: [[f64; 4]; 4] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| h[i][j] + (0..4).map(|l| f.a[l][i] * pa[l][j]).sum::<f64>())
+        });
+        let mut q_vv = [[0.0; MAX_FRAME_VARS]; MAX_FRAME_VARS];
+        let mut q_vx = [[0.0; 4]; MAX_FRAME_VARS];
+        for i in 0..nv {
+            for j in 0..nv {
+                q_vv[i][j] = h[4 + i][4 + j] + (0..4).map(|l| f.b[l][i] * pb[l][j]).sum::<f64>();
+            }
+            for j in 0..4 {
+                q_vx[i][j] = h[4 + i][j] + (0..4).map(|l| f.b[l][i] * pa[l][j]).sum::<f64>();
+            }
+        }
+        let chol = cholesky(&q_vv, nv).ok_or(NotStaged::Numerics)?;
+        let mut gain = [[0.0; 4]; MAX_FRAME_VARS];
+        for j in 0..4 {
+            let col: [f64; MAX_FRAME_VARS] = std::array::from_fn(|i| q_vx[i][j]);
+            let s = cholesky_solve(&chol, nv, &col);
+            for i in 0..nv {
+                gain[i][j] = -s[i];
+            }
+        }
+        // P = Q_xx + Q_vx' K, kept symmetric.
+        let p: [[f64; 4]; 4] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                q_xx[i][j] + (0..nv).map(|l| q_vx[l][i] * gain[l][j]).sum::<f64>()
+            })
+        });
+        value = std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (p[i][j] + p[j][i])));
+        factors[k] = FrameFactor { chol, q_vx, gain };
+    }
+    Ok(factors)
+}
+
+/// The Newton direction for complementarity residuals `rc` (`t lambda` minus the target), from the
+/// factorisation: the rows' weighted residuals enter the frames' gradients, the backward pass gives the
+/// feed-forward terms, the forward pass the step, and the rows give the slacks' and duals' changes.
+fn direction(
+    p: &StagedProblem,
+    frames: &[Frame],
+    offsets: &[usize],
+    factors: &[FrameFactor],
+    it: &Iterate,
+    rc: &[f64],
+) -> Result<Direction, NotStaged> {
+    let rp = &it.rp;
+    // Row i's weight in the gradient: lambda_i + (lambda_i rp_i - rc_i) / t_i.
+    let mut feed = vec![[0.0; MAX_FRAME_VARS]; frames.len()];
+    let mut cost_to_go = p.terminal_gradient;
+    for (k, f) in frames.iter().enumerate().rev() {
+        let nv = f.nv();
+        let xb = before(it, k);
+        let mut g = f.cost_gradient(&xb, &it.v[k]);
+        for (r, row) in f.rows.iter().enumerate() {
+            let i = offsets[k] + r;
+            row.add_to(
+                &mut g,
+                it.lambda[i] + (it.lambda[i] * rp[i] - rc[i]) / it.t[i],
+            );
+        }
+        let q_v: [f64; MAX_FRAME_VARS] = std::array::from_fn(|j| {
+            g[4 + j] + (0..4).map(|l| f.b[l][j] * cost_to_go[l]).sum::<f64>()
+        });
+        let s = cholesky_solve(&factors[k].chol, nv, &q_v);
+        let kk: [f64; MAX_FRAME_VARS] = std::array::from_fn(|j| -s[j]);
+        cost_to_go = std::array::from_fn(|j| {
+            g[j] + (0..4).map(|l| f.a[l][j] * cost_to_go[l]).sum::<f64>()
+                + (0..nv).map(|l| factors[k].q_vx[l][j] * kk[l]).sum::<f64>()
+        });
+        feed[k] = kk;
+    }
+    let mut dv = Vec::with_capacity(frames.len());
+    let mut dt = vec![0.0; it.t.len()];
+    let mut dlambda = vec![0.0; it.t.len()];
+    let mut dx_before = [0.0; 4];
+    for (k, f) in frames.iter().enumerate() {
+        let fk = &factors[k];
+        let step: [f64; MAX_FRAME_VARS] = std::array::from_fn(|j| {
+            feed[k][j] + (0..4).map(|l| fk.gain[j][l] * dx_before[l]).sum::<f64>()
+        });
+        for (r, row) in f.rows.iter().enumerate() {
+            let i = offsets[k] + r;
+            dt[i] = -rp[i] - f.row_value(row, &dx_before, &step);
+            dlambda[i] = (-rc[i] - it.lambda[i] * dt[i]) / it.t[i];
+        }
+        dx_before = f.step(&dx_before, &step);
+        dv.push(step);
+    }
+    if !dx_before.iter().all(|d| d.is_finite()) {
+        return Err(NotStaged::Numerics);
+    }
+    Ok(Direction { dv, dt, dlambda })
+}
+
+/// The longest step up to `share` of the way to the boundary of `t, lambda >= 0`, at most 1.
+fn step_to_boundary(it: &Iterate, dir: &Direction, share: f64) -> f64 {
+    let mut alpha = 1.0_f64;
+    for (x, d) in
+        it.t.iter()
+            .zip(&dir.dt)
+            .chain(it.lambda.iter().zip(&dir.dlambda))
+    {
+        if *d < 0.0 {
+            alpha = alpha.min(share * (-x / d));
+        }
+    }
+    alpha
+}
+
+/// The iterate moved by `alpha` along `dir`, its states played again through the dynamics.
+fn take_step(frames: &[Frame], it: &mut Iterate, dir: &Direction, alpha: f64) {
+    for (v, dv) in it.v.iter_mut().zip(&dir.dv) {
+        for (a, b) in v.iter_mut().zip(dv) {
+            *a += alpha * b;
+        }
+    }
+    for (t, d) in it.t.iter_mut().zip(&dir.dt) {
+        *t += alpha * d;
+    }
+    for (l, d) in it.lambda.iter_mut().zip(&dir.dlambda) {
+        *l += alpha * d;
+    }
+    for r in &mut it.rp {
+        *r *= 1.0 - alpha;
+    }
+    let mut x = [0.0; 4];
+    for (k, f) in frames.iter().enumerate() {
+        x = f.step(&x, &it.v[k]);
+        it.dx[k] = x;
+    }
+}
+
+/// Lower Cholesky factor of the leading `n x n` block of `a`; `None`: not positive definite.
+fn cholesky(
+    a: &[[f64; MAX_FRAME_VARS]; MAX_FRAME_VARS],
+    n: usize,
+) -> Option<[[f64; MAX_FRAME_VARS]; MAX_FRAME_VARS]> {
+    let mut l = [[0.0; MAX_FRAME_VARS]; MAX_FRAME_VARS];
+    for i in 0..n {
+        for j in 0..=i {
+            let s = a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+            if i == j {
+                if !(s > 0.0 && s.is_finite()) {
+                    return None;
+                }
+                l[i][i] = s.sqrt();
+            } else {
+                l[i][j] = s / l[j][j];
+            }
+        }
+    }
+    Some(l)
+}
+
+/// `x` with `L L' x = b` over the leading `n` entries.
+fn cholesky_solve(
+    l: &[[f64; MAX_FRAME_VARS]; MAX_FRAME_VARS],
+    n: usize,
+    b: &[f64; MAX_FRAME_VARS],
+) -> [f64; MAX_FRAME_VARS] {
+    let mut y = [0.0; MAX_FRAME_VARS];
+    for i in 0..n {
+        y[i] = (b[i] - (0..i).map(|k| l[i][k] * y[k]).sum::<f64>()) / l[i][i];
+    }
+    let mut x = [0.0; MAX_FRAME_VARS];
+    for i in (0..n).rev() {
+        x[i] = (y[i] - (i + 1..n).map(|k| l[k][i] * x[k]).sum::<f64>()) / l[i][i];
+    }
+    x
+}
+
+/// The iterate in Clarabel's layout, with the duals of the dynamics rows: `z_k = -a_k`, `a_k` the
+/// gradient of the Lagrangian in the state change after frame `k` through all later frames (its
+/// direct terms: the next frame's curvature, the last frame's progress and the wall rows of frame `k`'s
+/// end, which the frames hold through their dynamics and so are added back here).
+fn solution(
+    p: &StagedProblem,
+    frames: &[Frame],
+    wall_rows: &[RowAt],
+    offsets: &[usize],
+    it: &Iterate,
+    almost: bool,
+) -> StagedSolution {
+    let n = frames.len();
+    let mut x = vec![0.0; p.n_controls + 4 * n + p.n_slacks];
+    for (k, f) in frames.iter().enumerate() {
+        for (at, var) in f.vars.iter().enumerate() {
+            match *var {
+                FrameVar::Control { var, .. } => x[var] = it.v[k][at],
+                FrameVar::Slack { slack } => x[p.n_controls + 4 * n + slack] = it.v[k][at],
+            }
+        }
+        for i in 0..4 {
+            x[p.n_controls + 4 * k + i] = it.dx[k][i];
+        }
+    }
+    // Per frame end, the wall rows' pull on its position: sum of lambda (-n).
+    let mut wall_pull = vec![[0.0; 4]; n];
+    for (w, &(k, r)) in p.walls.iter().zip(wall_rows) {
+        let l = it.lambda[offsets[k] + r];
+        wall_pull[w.frame][0] -= l * w.plane.normal.x;
+        wall_pull[w.frame][1] -= l * w.plane.normal.y;
+    }
+    let mut adjoint = [0.0; 4];
+    let mut duals = vec![[0.0; 4]; n];
+    for k in (0..n).rev() {
+        let mut direct = wall_pull[k];
+        if k + 1 == n {
+            for (d, g) in direct.iter_mut().zip(&p.terminal_gradient) {
+                *d += g;
+            }
+        } else {
+            let f = &frames[k + 1];
+            let g = f.cost_gradient(&it.dx[k], &it.v[k + 1]);
+            for i in 0..4 {
+                // The next frame's cost in the incoming state, less its constant gradient (none there).
+                direct[i] += g[i] - f.gradient[i];
+            }
+        }
+        let next_a = if k + 1 < n {
+            frames[k + 1].a
+        } else {
+            [[0.0; 4]; 4]
+        };
+        adjoint = std::array::from_fn(|j| {
+            direct[j] + (0..4).map(|i| next_a[i][j] * adjoint[i]).sum::<f64>()
+        });
+        duals[k] = adjoint.map(|a| -a);
+    }
+    StagedSolution {
+        x,
+        dynamics_duals: duals,
+        almost,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::HalfPlane;
+    use crate::physics::Vec2;
+
+    /// One frame that carries the state over, its side moving the end position along `y` and its `c`
+    /// along `x` (progress), both within a unit box; the wall rows `walls` on frame 0 with their slacks.
+    fn one_frame(
+        walls: &[WallRow],
+        row_slack: &[usize],
+        n_slacks: usize,
+        time_limit_s: f64,
+    ) -> Result<StagedSolution, NotStaged> {
+        let mut a = [[0.0; 4]; 4];
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] = 1.0;
+        }
+        let jacobians = [FrameJacobian {
+            a,
+            b: [[0.0, 1.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
+        }];
+        let rhs = vec![0.5; walls.len()];
+        let p = StagedProblem {
+            jacobians: &jacobians,
+            control_var: &[Some(0), Some(1)],
+            n_controls: 2,
+            control_ranges: &[[(1.0, 1.0), (1.0, 1.0)]],
+            walls,
+            wall_rhs: &rhs,
+            row_slack,
+            n_slacks,
+            slack_weight: 100.0,
+            terminal_gradient: [-1.0, 0.0, 0.0, 0.0],
+            curvature: None,
+        };
+        solve(&p, 100, time_limit_s)
+    }
+
+    /// A wall keeping the end position at `y <= 0.5` (the row `-n . dp - s <= 0.5`, `n = (0, -1)`).
+    fn wall(group: usize) -> WallRow {
+        WallRow {
+            frame: 0,
+            group,
+            plane: HalfPlane {
+                normal: Vec2::new(0.0, -1.0),
+                offset: 0.0,
+            },
+        }
+    }
+
+    #[test]
+    fn two_slacks_ending_at_one_frame_are_not_a_chain() {
+        let walls = [wall(0), wall(1)];
+        let shared = one_frame(&walls, &[0, 0], 1, 10.0);
+        let solved = shared.as_ref().map_err(|e| format!("{e:?}"));
+        // c rises to its bound (progress); the wall's rows bind nothing at y = 0, so its slack is zero.
+        let x = solved.map(|s| s.x.clone()).unwrap_or_default();
+        assert!((x[1] - 1.0).abs() < 1e-5, "{x:?}");
+        assert!(x[2 + 4].abs() < 1e-5, "{x:?}");
+        assert_eq!(
+            one_frame(&walls, &[0, 1], 2, 10.0).err(),
+            Some(NotStaged::NotAChain)
+        );
+    }
+
+    #[test]
+    fn a_solve_out_of_time_stops_and_says_so() {
+        let walls = [wall(0)];
+        assert_eq!(
+            one_frame(&walls, &[0], 1, 0.0).err(),
+            Some(NotStaged::TimeLimit)
+        );
+        assert!(one_frame(&walls, &[0], 1, 10.0).is_ok());
+    }
+}
