@@ -8,14 +8,14 @@
 //! curvature couples `dx_{k-1}` and `v_k` only; progress is linear in the last state. A general sparse
 //! factorisation of its KKT system (Clarabel's) does not use that chain; the recursion needs per frame a
 //! handful of 4x4 products and the Cholesky factor of a matrix at most 3x3, and solves a sub-problem
-//! three to five times faster than Clarabel (docs/design.md, "The sub-problem solved frame by frame").
+//! three to eight times faster than Clarabel (docs/design.md, "The sub-problem solved frame by frame").
 //!
 //! Per interior-point iteration: the inequality rows `G z + t = h` with slacks `t >= 0` and duals
 //! `lambda >= 0` are eliminated (weights `lambda / t`), which leaves an equality-constrained QP in the
 //! frames' variables; its backward Riccati pass gives the feedback `v_k = K_k dx_{k-1} + k_k`, its
-//! forward pass the step. The start is strictly feasible (controls at the centre of their boxes, slacks
-//! above every row's violation), so the rows stay met and only complementarity and stationarity are
-//! driven to zero.
+//! forward pass the step. The rows' residuals `G z + t - h` start where the first iterate puts them
+//! ([`started`]) and shrink by `1 - alpha` with every step of length `alpha` (the rows are linear), so
+//! they are tracked, not recomputed, until the tolerances are checked.
 
 use super::lagrangian::CurvatureBlock;
 use super::model::FrameJacobian;
