@@ -85,12 +85,14 @@ pub enum SubProblemSolver {
     Clarabel,
 }
 
-/// How a sub-problem ended, mapped from Clarabel's status in one place.
+/// How a sub-problem ended: the frame-by-frame solver's solution, or Clarabel's status mapped in one
+/// place.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SubStepStatus {
     /// Solved (possibly to reduced accuracy): the step is usable.
     Solved {
-        /// Reduced accuracy (`AlmostSolved`).
+        /// Reduced accuracy (Clarabel's `AlmostSolved`, or the frame-by-frame solver's looser
+        /// tolerances at its iteration cap).
         almost: bool,
     },
     /// Clarabel stopped without a usable step (infeasible certificate, iteration or time limit, numerical
@@ -144,13 +146,15 @@ pub fn solve(sp: &SubProblem) -> SubStep {
     solve_capped(sp, MAX_SUBPROBLEM_ITERATIONS)
 }
 
-/// [`solve`] stopped after `time_limit_s` seconds (Clarabel's own clock; infinite: no limit): a
-/// sub-problem cut short is a failed step (`MaxTime`), so the search's deadline holds inside one too.
+/// [`solve`] stopped after `time_limit_s` seconds (the solvers' own clocks, the frame-by-frame solver's
+/// and then Clarabel's in the time left; infinite: no limit): a sub-problem cut short is a failed step,
+/// so the search's deadline holds inside one too.
 pub fn solve_within_time(sp: &SubProblem, time_limit_s: f64) -> SubStep {
     solve_limited(sp, MAX_SUBPROBLEM_ITERATIONS, time_limit_s)
 }
 
-/// [`solve`] with Clarabel's iteration cap given (tests force its `MaxIterations` status with it).
+/// [`solve`] with the solvers' interior-point iteration cap given (tests force Clarabel's
+/// `MaxIterations` status with it).
 pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
     solve_limited(sp, max_iterations, f64::INFINITY)
 }
@@ -530,8 +534,8 @@ fn predicted_gain(sp: &SubProblem, layout: &Layout, x: &[f64]) -> f64 {
     progress_gain + sp.slack_weight * (viol_before - viol_after) - curvature_term
 }
 
-/// What Clarabel returned for a solved sub-problem: the primal `x` and the duals `z` (Clarabel's
-/// convention `P x + q + A' z = 0`).
+/// A solved sub-problem, from either solver: the primal `x` and the duals `z`, those of the dynamics
+/// rows first (Clarabel's convention `P x + q + A' z = 0`).
 struct Solution {
     status: SubStepStatus,
     x: Vec<f64>,
