@@ -26,6 +26,16 @@ use clarabel::solver::{
 
 /// `c` enters the sub-problem divided by this (ups), so both controls have unit scale.
 pub const C_SCALE_UPS: f64 = 10.0;
+/// The scale of control `j` (0: the side, 1: `c`) in the sub-problem: its variable is its change divided
+/// by this.
+pub(super) fn control_scale(j: usize) -> f64 {
+    if j == 1 {
+        C_SCALE_UPS
+    } else {
+        1.0
+    }
+}
+
 /// Weight of the control changes in the objective (keeps the sub-problem strictly convex in them).
 pub const CONTROL_REGULARISATION: f64 = 1e-6;
 
@@ -167,51 +177,49 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     let started = std::time::Instant::now();
     let staged = match sp.solver {
         SubProblemSolver::Riccati => {
-            stagewise::solve(&layout.staged(sp, &rhs), max_iterations, time_limit_s).ok()
+            let problem = stagewise::StagedProblem::new(sp, &layout, &rhs);
+            stagewise::solve(&problem, max_iterations, time_limit_s).ok()
         }
         SubProblemSolver::Clarabel => None,
     };
-    let solution = match staged {
-        Some(s) => Solution {
-            status: SubStepStatus::Solved { almost: s.almost },
-            x: s.x,
-            z: s.dynamics_duals.into_iter().flatten().collect(),
-        },
-        None => {
-            let left_s = time_limit_s - started.elapsed().as_secs_f64();
-            match clarabel_solved(sp, &layout, &rhs, max_iterations, left_s) {
-                Ok(solution) if solution.x.len() == layout.n_vars() => solution,
-                Ok(_) => {
-                    return SubStep::failed(SubStepStatus::Failed(
-                        "solution of the wrong size".into(),
-                    ))
-                }
-                Err(no) => return SubStep::failed(SubStepStatus::Failed(no.to_string())),
-            }
+    if let Some(s) = staged {
+        let status = SubStepStatus::Solved { almost: s.almost };
+        return sub_step_of(sp, &layout, status, s.x, s.dynamics_duals);
+    }
+    let left_s = time_limit_s - started.elapsed().as_secs_f64();
+    match clarabel_solved(sp, &layout, &rhs, max_iterations, left_s) {
+        Ok(solution) if solution.x.len() == layout.n_vars() => {
+            // Clarabel's duals begin with those of the dynamics rows, four a frame.
+            let z = &solution.z;
+            let duals = (0..layout.n_frames)
+                .map(|k| std::array::from_fn(|i| z.get(4 * k + i).copied().unwrap_or(0.0)))
+                .collect();
+            sub_step_of(sp, &layout, solution.status, solution.x, duals)
         }
-    };
-    sub_step_of(sp, &layout, solution)
+        Ok(_) => SubStep::failed(SubStepStatus::Failed("solution of the wrong size".into())),
+        Err(no) => SubStep::failed(SubStepStatus::Failed(no.to_string())),
+    }
 }
 
 /// Where each variable of a sub-problem sits: the free controls first, then `4 n` state changes, then
-/// one slack per group of wall rows.
-struct Layout {
+/// one slack per group of wall rows. Both solvers read and write it.
+pub(super) struct Layout {
     /// Per frame `k` and control `j`, at `2 k + j`, its variable; `None`: fixed.
     control_var: Vec<Option<usize>>,
     /// Free controls.
     n_controls: usize,
     /// Frames.
-    n_frames: usize,
+    pub(super) n_frames: usize,
     /// Per wall row, its slack.
-    row_slack: Vec<usize>,
+    pub(super) row_slack: Vec<usize>,
     /// Slacks (groups of wall rows).
-    n_slacks: usize,
+    pub(super) n_slacks: usize,
     /// Per frame, each control's allowed change `[-lo, hi]`, scaled.
-    ranges: Vec<[(f64, f64); 2]>,
+    pub(super) ranges: Vec<[(f64, f64); 2]>,
 }
 
 impl Layout {
-    fn of(sp: &SubProblem) -> Layout {
+    pub(super) fn of(sp: &SubProblem) -> Layout {
         let n = sp.jacobians.len();
         // One slack per group of wall rows, numbered in order of first appearance.
         let mut slack_of_group: Vec<Option<usize>> = Vec::new();
@@ -262,49 +270,32 @@ impl Layout {
     }
 
     /// The variable of control `j` of frame `k`; `None`: fixed.
-    fn iu(&self, k: usize, j: usize) -> Option<usize> {
+    pub(super) fn iu(&self, k: usize, j: usize) -> Option<usize> {
         self.control_var[2 * k + j]
     }
 
     /// The variable of state change `i` after frame `k`.
-    fn ix(&self, k: usize, i: usize) -> usize {
+    pub(super) fn ix(&self, k: usize, i: usize) -> usize {
         self.n_controls + 4 * k + i
     }
 
     /// The variable of slack `j`.
-    fn is(&self, j: usize) -> usize {
+    pub(super) fn is(&self, j: usize) -> usize {
         self.n_controls + 4 * self.n_frames + j
     }
 
-    fn n_vars(&self) -> usize {
+    pub(super) fn n_vars(&self) -> usize {
         self.n_controls + 4 * self.n_frames + self.n_slacks
-    }
-
-    /// The sub-problem as a chain of frames for [`stagewise::solve`], laid out as here.
-    fn staged<'a>(&'a self, sp: &SubProblem<'a>, rhs: &'a [f64]) -> stagewise::StagedProblem<'a> {
-        stagewise::StagedProblem {
-            jacobians: sp.jacobians,
-            control_var: &self.control_var,
-            n_controls: self.n_controls,
-            control_ranges: &self.ranges,
-            walls: sp.walls,
-            wall_rhs: rhs,
-            row_slack: &self.row_slack,
-            n_slacks: self.n_slacks,
-            slack_weight: sp.slack_weight,
-            terminal_gradient: [-sp.progress_dir.x, -sp.progress_dir.y, 0.0, 0.0],
-            curvature: sp.curvature,
-        }
     }
 
     /// Per frame `k`, the variables of the curvature block's inputs `(V_{k-1}, psi_{k-1}, sigma_k,
     /// c_k)` with their scales.
-    fn curvature_vars(&self, k: usize) -> [Option<(usize, f64)>; 4] {
+    pub(super) fn curvature_vars(&self, k: usize) -> [Option<(usize, f64)>; 4] {
         [
             (k > 0).then(|| (self.ix(k.saturating_sub(1), 2), 1.0)),
             (k > 0).then(|| (self.ix(k.saturating_sub(1), 3), 1.0)),
-            self.iu(k, 0).map(|v| (v, 1.0)),
-            self.iu(k, 1).map(|v| (v, C_SCALE_UPS)),
+            self.iu(k, 0).map(|v| (v, control_scale(0))),
+            self.iu(k, 1).map(|v| (v, control_scale(1))),
         ]
     }
 }
@@ -379,10 +370,9 @@ fn clarabel_rows(
                     continue;
                 }
                 if let Some(var) = iu(k, j) {
-                    let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
                     ri.push(row);
                     ci.push(var);
-                    vals.push(-bb * scale);
+                    vals.push(-bb * control_scale(j));
                 }
             }
             b.push(0.0);
@@ -462,34 +452,31 @@ fn clarabel_objective(sp: &SubProblem, layout: &Layout) -> (CscMatrix<f64>, Vec<
     (p, q)
 }
 
-/// The sub-step of a solution: its control changes, the state changes they give, what the model
-/// predicts the step gains, and the duals of the dynamics rows.
-fn sub_step_of(sp: &SubProblem, layout: &Layout, solution: Solution) -> SubStep {
+/// The sub-step of a solution `x` (laid out by `layout`) with the duals of its dynamics rows: its
+/// control changes, the state changes they give, and what the model predicts the step gains.
+fn sub_step_of(
+    sp: &SubProblem,
+    layout: &Layout,
+    status: SubStepStatus,
+    x: Vec<f64>,
+    dynamics_duals: Vec<[f64; 4]>,
+) -> SubStep {
     let n = layout.n_frames;
     // The step is judged on what its control changes do: a solver meets the dynamics rows only to its
     // feasibility tolerance, and along a chain of thousands of frames their residuals add up.
-    let x = with_the_states_of_its_controls(
-        sp.jacobians,
-        solution.x,
-        |k, j| layout.iu(k, j),
-        |k, i| layout.ix(k, i),
-    );
+    let x = with_the_states_of_its_controls(sp.jacobians, x, layout);
     let du: Vec<(f64, f64)> = (0..n)
         .map(|k| {
-            let change = |j: usize| layout.iu(k, j).map_or(0.0, |v| x[v]);
-            (change(0), change(1) * C_SCALE_UPS)
+            let change = |j: usize| layout.iu(k, j).map_or(0.0, |v| x[v] * control_scale(j));
+            (change(0), change(1))
         })
         .collect();
     let dp: Vec<crate::physics::Vec2> = (0..n)
         .map(|k| crate::physics::Vec2::new(x[layout.ix(k, 0)], x[layout.ix(k, 1)]))
         .collect();
     let predicted = predicted_gain(sp, layout, &x);
-    let z = &solution.z;
-    let dynamics_duals = (0..n)
-        .map(|k| std::array::from_fn(|i| z.get(4 * k + i).copied().unwrap_or(0.0)))
-        .collect();
     SubStep {
-        status: solution.status,
+        status,
         du,
         dp,
         predicted,
@@ -534,8 +521,8 @@ fn predicted_gain(sp: &SubProblem, layout: &Layout, x: &[f64]) -> f64 {
     progress_gain + sp.slack_weight * (viol_before - viol_after) - curvature_term
 }
 
-/// A solved sub-problem, from either solver: the primal `x` and the duals `z`, those of the dynamics
-/// rows first (Clarabel's convention `P x + q + A' z = 0`).
+/// What Clarabel returned for a solved sub-problem: the primal `x` and the duals `z`, those of the
+/// dynamics rows first (Clarabel's convention `P x + q + A' z = 0`).
 struct Solution {
     status: SubStepStatus,
     x: Vec<f64>,
@@ -660,18 +647,15 @@ fn clarabel_run(
 fn with_the_states_of_its_controls(
     jacobians: &[FrameJacobian],
     mut x: Vec<f64>,
-    iu: impl Fn(usize, usize) -> Option<usize>,
-    ix: impl Fn(usize, usize) -> usize,
+    layout: &Layout,
 ) -> Vec<f64> {
     let mut before = [0.0; 4];
     for (k, jac) in jacobians.iter().enumerate() {
-        let du: [f64; 2] = std::array::from_fn(|j| {
-            let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
-            iu(k, j).map_or(0.0, |v| x[v] * scale)
-        });
+        let du: [f64; 2] =
+            std::array::from_fn(|j| layout.iu(k, j).map_or(0.0, |v| x[v] * control_scale(j)));
         let after = jac.state_change(&before, &du);
         for (i, &d) in after.iter().enumerate() {
-            x[ix(k, i)] = d;
+            x[layout.ix(k, i)] = d;
         }
         before = after;
     }
@@ -1063,8 +1047,11 @@ mod tests {
             };
             let layout = Layout::of(&sp);
             let rhs = wall_rhs(&sp);
-            let staged =
-                stagewise::solve(&layout.staged(&sp, &rhs), MAX_SUBPROBLEM_ITERATIONS, 10.0);
+            let staged = stagewise::solve(
+                &stagewise::StagedProblem::new(&sp, &layout, &rhs),
+                MAX_SUBPROBLEM_ITERATIONS,
+                10.0,
+            );
             assert!(staged.is_ok(), "case {case}: {:?}", staged.err());
             let [riccati, clarabel] = by_each_solver(&sp);
             assert_eq!(

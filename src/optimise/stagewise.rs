@@ -17,40 +17,35 @@
 //! ([`started`]) and shrink by `1 - alpha` with every step of length `alpha` (the rows are linear), so
 //! they are tracked, not recomputed, until the tolerances are checked.
 
-use super::lagrangian::CurvatureBlock;
-use super::model::FrameJacobian;
 use super::qp::{
-    WallRow, CONTROL_REGULARISATION, C_SCALE_UPS, SUBPROBLEM_FEAS_TOL, SUBPROBLEM_GAP_TOL,
+    control_scale, Layout, SubProblem, CONTROL_REGULARISATION, SUBPROBLEM_FEAS_TOL,
+    SUBPROBLEM_GAP_TOL,
 };
 
 /// Most variables a frame has: its two controls and one slack.
 const MAX_FRAME_VARS: usize = 3;
 
-/// The sub-problem laid out as [`super::qp`] lays it out for Clarabel (the same variables, indexed the
-/// same way), so that a solution of either solver is read by the same code.
+/// The sub-problem with its layout (the variables indexed as for Clarabel, so that a solution of either
+/// solver is read by the same code) and its wall rows' right-hand sides.
 pub(super) struct StagedProblem<'a> {
-    /// Per frame, the Jacobian of the frame.
-    pub jacobians: &'a [FrameJacobian],
-    /// Variable of control `j` of frame `k` at `2 k + j`; `None`: fixed.
-    pub control_var: &'a [Option<usize>],
-    /// Number of control variables (they come first).
-    pub n_controls: usize,
-    /// Per frame, the allowed change `[-lo, hi]` of its two controls, scaled (`c` by [`C_SCALE_UPS`]).
-    pub control_ranges: &'a [[(f64, f64); 2]],
-    /// Wall rows, their right-hand sides (`-n . dp - s <= rhs`) and the slack each shares.
-    pub walls: &'a [WallRow],
-    /// Per wall row, its right-hand side, units.
-    pub wall_rhs: &'a [f64],
-    /// Per wall row, the index of its slack among the slacks.
-    pub row_slack: &'a [usize],
-    /// Number of slacks (they come after the controls and the `4 n` state changes).
-    pub n_slacks: usize,
-    /// Weight of a unit of slack.
-    pub slack_weight: f64,
+    sp: &'a SubProblem<'a>,
+    layout: &'a Layout,
+    wall_rhs: &'a [f64],
     /// Gradient of the objective in the last state change (minus the progress direction).
-    pub terminal_gradient: [f64; 4],
-    /// Per frame, the curvature block in `(V_{k-1}, psi_{k-1}, sigma_k, c_k)`, if any.
-    pub curvature: Option<&'a [CurvatureBlock]>,
+    terminal_gradient: [f64; 4],
+}
+
+impl<'a> StagedProblem<'a> {
+    /// `sp` laid out by `layout`, its wall rows' right-hand sides `wall_rhs` (units).
+    pub(super) fn new(sp: &'a SubProblem<'a>, layout: &'a Layout, wall_rhs: &'a [f64]) -> Self {
+        let n = sp.progress_dir;
+        StagedProblem {
+            sp,
+            layout,
+            wall_rhs,
+            terminal_gradient: [-n.x, -n.y, 0.0, 0.0],
+        }
+    }
 }
 
 /// A solution in Clarabel's layout: the primal `x` and, per frame, the duals of its dynamics rows in
@@ -177,10 +172,10 @@ type RowAt = (usize, usize);
 /// The frames of `p` and, per wall row, its frame and its index among the frame's rows; or
 /// [`NotStaged::NotAChain`].
 fn frames_of(p: &StagedProblem) -> Result<(Vec<Frame>, Vec<RowAt>), NotStaged> {
-    let n = p.jacobians.len();
+    let n = p.sp.jacobians.len();
     // Each slack belongs to the last frame of its rows; its rows must be at that frame or the one before.
-    let mut slack_frame = vec![0usize; p.n_slacks];
-    for (w, &s) in p.walls.iter().zip(p.row_slack) {
+    let mut slack_frame = vec![0usize; p.layout.n_slacks];
+    for (w, &s) in p.sp.walls.iter().zip(&p.layout.row_slack) {
         slack_frame[s] = slack_frame[s].max(w.frame);
     }
     let mut slack_of_frame: Vec<Option<usize>> = vec![None; n];
@@ -192,8 +187,8 @@ fn frames_of(p: &StagedProblem) -> Result<(Vec<Frame>, Vec<RowAt>), NotStaged> {
     let mut frames: Vec<Frame> = (0..n)
         .map(|k| frame_without_walls(p, k, slack_of_frame[k]))
         .collect();
-    let mut wall_rows = Vec::with_capacity(p.walls.len());
-    for ((w, &rhs), &s) in p.walls.iter().zip(p.wall_rhs).zip(p.row_slack) {
+    let mut wall_rows = Vec::with_capacity(p.sp.walls.len());
+    for ((w, &rhs), &s) in p.sp.walls.iter().zip(p.wall_rhs).zip(&p.layout.row_slack) {
         let k = slack_frame[s];
         if w.frame + 1 < k {
             return Err(NotStaged::NotAChain);
@@ -226,9 +221,9 @@ fn frames_of(p: &StagedProblem) -> Result<(Vec<Frame>, Vec<RowAt>), NotStaged> {
 /// Frame `k` with its variables (free controls, then its slack if any), the rows of its controls'
 /// boxes and its slack's sign, and its cost.
 fn frame_without_walls(p: &StagedProblem, k: usize, slack: Option<usize>) -> Frame {
-    let jac = &p.jacobians[k];
+    let jac = &p.sp.jacobians[k];
     let mut vars: Vec<FrameVar> = (0..2)
-        .filter_map(|j| p.control_var[2 * k + j].map(|var| FrameVar::Control { j, var }))
+        .filter_map(|j| p.layout.iu(k, j).map(|var| FrameVar::Control { j, var }))
         .collect();
     vars.extend(slack.map(|slack| FrameVar::Slack { slack }));
     // The first frame starts from no change: its incoming state carries nothing.
@@ -241,11 +236,10 @@ fn frame_without_walls(p: &StagedProblem, k: usize, slack: Option<usize>) -> Fra
     for (at, var) in vars.iter().enumerate() {
         match *var {
             FrameVar::Control { j, .. } => {
-                let scale = if j == 1 { C_SCALE_UPS } else { 1.0 };
                 for (bi, ji) in b.iter_mut().zip(&jac.b) {
-                    bi[at] = ji[j] * scale;
+                    bi[at] = ji[j] * control_scale(j);
                 }
-                let (lo, hi) = p.control_ranges[k][j];
+                let (lo, hi) = p.layout.ranges[k][j];
                 centre[at] = 0.5 * (hi - lo);
                 rows.push(Row::bound(at, 1.0, hi));
                 rows.push(Row::bound(at, -1.0, lo));
@@ -253,24 +247,25 @@ fn frame_without_walls(p: &StagedProblem, k: usize, slack: Option<usize>) -> Fra
             }
             FrameVar::Slack { .. } => {
                 rows.push(Row::bound(at, -1.0, 0.0));
-                gradient[4 + at] = p.slack_weight;
+                gradient[4 + at] = p.sp.slack_weight;
             }
         }
     }
-    if let Some(block) = p.curvature.and_then(|c| c.get(k)) {
-        // The block's inputs (V_{k-1}, psi_{k-1}, sigma_k, c_k) as positions in z, with their scales.
-        let control_at = |j: usize| {
+    if let Some(block) = p.sp.curvature.and_then(|c| c.get(k)) {
+        // The block's inputs (V_{k-1}, psi_{k-1}, sigma_k, c_k) as the layout has them, placed in z: a
+        // state change before the frame at its index there, a control at its place among the frame's
+        // variables.
+        let in_z = |var: usize| {
             vars.iter()
-                .position(|v| matches!(v, FrameVar::Control { j: vj, .. } if *vj == j))
+                .position(|v| matches!(v, FrameVar::Control { var: w, .. } if *w == var))
+                .map_or_else(|| var - p.layout.ix(k.saturating_sub(1), 0), |at| 4 + at)
         };
-        let at: [Option<(usize, f64)>; 4] = [
-            (k > 0).then_some((2, 1.0)),
-            (k > 0).then_some((3, 1.0)),
-            control_at(0).map(|i| (4 + i, 1.0)),
-            control_at(1).map(|i| (4 + i, C_SCALE_UPS)),
-        ];
-        for (i, ai) in at.iter().enumerate() {
-            for (j, aj) in at.iter().enumerate() {
+        let inputs = p
+            .layout
+            .curvature_vars(k)
+            .map(|v| v.map(|(var, s)| (in_z(var), s)));
+        for (i, ai) in inputs.iter().enumerate() {
+            for (j, aj) in inputs.iter().enumerate() {
                 if let (Some((r, sr)), Some((c, sc))) = (ai, aj) {
                     hessian[*r][*c] += block[i][j] * sr * sc;
                 }
@@ -778,21 +773,22 @@ fn solution(
     almost: bool,
 ) -> StagedSolution {
     let n = frames.len();
-    let mut x = vec![0.0; p.n_controls + 4 * n + p.n_slacks];
+    let layout = p.layout;
+    let mut x = vec![0.0; layout.n_vars()];
     for (k, f) in frames.iter().enumerate() {
         for (at, var) in f.vars.iter().enumerate() {
             match *var {
                 FrameVar::Control { var, .. } => x[var] = it.v[k][at],
-                FrameVar::Slack { slack } => x[p.n_controls + 4 * n + slack] = it.v[k][at],
+                FrameVar::Slack { slack } => x[layout.is(slack)] = it.v[k][at],
             }
         }
         for i in 0..4 {
-            x[p.n_controls + 4 * k + i] = it.dx[k][i];
+            x[layout.ix(k, i)] = it.dx[k][i];
         }
     }
     // Per frame end, the wall rows' pull on its position: sum of lambda (-n).
     let mut wall_pull = vec![[0.0; 4]; n];
-    for (w, &(k, r)) in p.walls.iter().zip(wall_rows) {
+    for (w, &(k, r)) in p.sp.walls.iter().zip(wall_rows) {
         let l = it.lambda[offsets[k] + r];
         wall_pull[w.frame][0] -= l * w.plane.normal.x;
         wall_pull[w.frame][1] -= l * w.plane.normal.y;
@@ -806,11 +802,10 @@ fn solution(
                 *d += g;
             }
         } else {
-            let f = &frames[k + 1];
-            let g = f.cost_gradient(&it.dx[k], &it.v[k + 1]);
-            for i in 0..4 {
-                // The next frame's cost in the incoming state, less its constant gradient (none there).
-                direct[i] += g[i] - f.gradient[i];
+            // The next frame's cost in its incoming state (its constant gradient has no state part).
+            let g = frames[k + 1].cost_gradient(&it.dx[k], &it.v[k + 1]);
+            for (d, gi) in direct.iter_mut().zip(&g) {
+                *d += gi;
             }
         }
         let next_a = if k + 1 < n {
@@ -834,39 +829,39 @@ fn solution(
 mod tests {
     use super::*;
     use crate::geometry::HalfPlane;
+    use crate::optimise::model::FrameJacobian;
+    use crate::optimise::qp::{SubProblemSolver, WallRow, C_SCALE_UPS};
     use crate::physics::Vec2;
 
     /// One frame that carries the state over, its side moving the end position along `y` and its `c`
-    /// along `x` (progress), both within a unit box; the wall rows `walls` on frame 0 with their slacks.
-    fn one_frame(
-        walls: &[WallRow],
-        row_slack: &[usize],
-        n_slacks: usize,
-        time_limit_s: f64,
-    ) -> Result<StagedSolution, NotStaged> {
+    /// along `x` (progress), both within a unit box (scaled); the wall rows `walls` on frame 0, each
+    /// with the right-hand side 0.5.
+    fn one_frame(walls: &[WallRow], time_limit_s: f64) -> Result<StagedSolution, NotStaged> {
         let mut a = [[0.0; 4]; 4];
         for (i, row) in a.iter_mut().enumerate() {
             row[i] = 1.0;
         }
         let jacobians = [FrameJacobian {
             a,
-            b: [[0.0, 1.0], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
+            b: [[0.0, 1.0 / C_SCALE_UPS], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
         }];
-        let rhs = vec![0.5; walls.len()];
-        let p = StagedProblem {
+        let sp = SubProblem {
             jacobians: &jacobians,
-            control_var: &[Some(0), Some(1)],
-            n_controls: 2,
-            control_ranges: &[[(1.0, 1.0), (1.0, 1.0)]],
+            positions: &[Vec2::new(5.0, 0.0)],
             walls,
-            wall_rhs: &rhs,
-            row_slack,
-            n_slacks,
+            margin: 0.0,
+            accepted_clearance: 0.0,
             slack_weight: 100.0,
-            terminal_gradient: [-1.0, 0.0, 0.0, 0.0],
+            progress_dir: Vec2::new(1.0, 0.0),
+            sigma_range: &[(1.0, 1.0)],
+            c_range: &[(C_SCALE_UPS, C_SCALE_UPS)],
             curvature: None,
+            wall_shift: None,
+            solver: SubProblemSolver::Riccati,
         };
-        solve(&p, 100, time_limit_s)
+        let layout = Layout::of(&sp);
+        let rhs = vec![0.5; walls.len()];
+        solve(&StagedProblem::new(&sp, &layout, &rhs), 100, time_limit_s)
     }
 
     /// A wall keeping the end position at `y <= 0.5` (the row `-n . dp - s <= 0.5`, `n = (0, -1)`).
@@ -884,25 +879,19 @@ mod tests {
     #[test]
     fn two_slacks_ending_at_one_frame_are_not_a_chain() {
         let walls = [wall(0), wall(1)];
-        let shared = one_frame(&walls, &[0, 0], 1, 10.0);
+        let shared = one_frame(&[wall(0), wall(0)], 10.0);
         let solved = shared.as_ref().map_err(|e| format!("{e:?}"));
         // c rises to its bound (progress); the wall's rows bind nothing at y = 0, so its slack is zero.
         let x = solved.map(|s| s.x.clone()).unwrap_or_default();
         assert!((x[1] - 1.0).abs() < 1e-5, "{x:?}");
         assert!(x[2 + 4].abs() < 1e-5, "{x:?}");
-        assert_eq!(
-            one_frame(&walls, &[0, 1], 2, 10.0).err(),
-            Some(NotStaged::NotAChain)
-        );
+        assert_eq!(one_frame(&walls, 10.0).err(), Some(NotStaged::NotAChain));
     }
 
     #[test]
     fn a_solve_out_of_time_stops_and_says_so() {
         let walls = [wall(0)];
-        assert_eq!(
-            one_frame(&walls, &[0], 1, 0.0).err(),
-            Some(NotStaged::TimeLimit)
-        );
-        assert!(one_frame(&walls, &[0], 1, 10.0).is_ok());
+        assert_eq!(one_frame(&walls, 0.0).err(), Some(NotStaged::TimeLimit));
+        assert!(one_frame(&walls, 10.0).is_ok());
     }
 }
