@@ -178,7 +178,15 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     let staged = match sp.solver {
         SubProblemSolver::Riccati => {
             let problem = stagewise::StagedProblem::new(sp, &layout, &rhs);
-            stagewise::solve(&problem, max_iterations, time_limit_s).ok()
+            match stagewise::solve(&problem, max_iterations, time_limit_s) {
+                Ok(solution) => Some(solution),
+                // Clarabel would have no time left either: setting it up would be work after the
+                // deadline (on a run of thousands of frames, tenths of a second).
+                Err(stagewise::NotStaged::TimeLimit) => {
+                    return SubStep::failed(SubStepStatus::Failed("time limit reached".into()))
+                }
+                Err(_) => None,
+            }
         }
         SubProblemSolver::Clarabel => None,
     };
@@ -729,6 +737,23 @@ mod tests {
     fn by_each_solver(sp: &SubProblem) -> [SubStep; 2] {
         [SubProblemSolver::Riccati, SubProblemSolver::Clarabel]
             .map(|solver| solve(&SubProblem { solver, ..*sp }))
+    }
+
+    #[test]
+    fn a_sub_problem_out_of_time_frame_by_frame_is_not_handed_to_clarabel() {
+        let (j, p, w) = one_frame(jacobian(0.01), 10.0);
+        let ranges = [(1.0, 1.0)];
+        let sp = sub(&j, &p, &w, &ranges);
+        assert_eq!(sp.solver, SubProblemSolver::Riccati);
+        let r = solve_within_time(&sp, 0.0);
+        // Clarabel, given no time, reports its own status; this one is the frame-by-frame solver's.
+        assert_eq!(
+            r.status,
+            SubStepStatus::Failed("time limit reached".into()),
+            "{:?}",
+            r.status
+        );
+        assert!(r.du.is_empty(), "{:?}", r.du);
     }
 
     #[test]
