@@ -261,7 +261,11 @@ pub(super) struct Descended {
 /// The search over the number of planning steps (frames or knots, as `search` says): SCP at `n` steps
 /// from `controls`, then at one step fewer than the plan's crossing, until the line is no longer reached
 /// (or `lo` steps, below which the bound says it cannot be); more steps if the first count does not reach
-/// it (at most `search.grow_tries` times).
+/// it (at most `search.grow_tries` times). Where the count below the best line is not reached but the
+/// stage that found the line was cut by its iteration cap, the search first goes on at the line's own
+/// count (each stage starts its trust region afresh, so a line found by a cut stage is not its count's
+/// best, and a count below it can be reachable from a better one), at most the settings'
+/// `capped_line_returns` times.
 pub(super) fn count_search<'a>(
     planner: &mut Planner<'a>,
     progress: &mut dyn FnMut(Progress),
@@ -278,11 +282,16 @@ pub(super) fn count_search<'a>(
     let problem = |p: &Planner<'a>| relaxed_problem(p, relaxation, frames_per_knot);
     let fl = planner.fl;
     let relaxed_iters = planner.settings.relaxed_iters;
+    let max_returns = planner.settings.capped_line_returns;
     // A sub-problem has at least one step to plan (an empty one is no problem for the solver).
     n = n.max(1);
     let mut best: Option<Vec<FrameControl>> = None;
     let mut grow_tries = 0;
     let mut continue_tries = 0;
+    // Whether the stage that found `best` stopped at its iteration cap, and the times the search went
+    // back to it.
+    let mut best_capped = false;
+    let mut returns = 0;
     let short = loop {
         if planner.out_of_time() {
             planner.note_cut(Stage::Relaxed);
@@ -310,6 +319,7 @@ pub(super) fn count_search<'a>(
         match reached {
             Some(k) if clean => {
                 best = Some(c[..k].to_vec());
+                best_capped = capped;
                 // One step short of this plan's crossing, warm-started from it: each solve keeps
                 // improving the same line (stepping further on a failed probe proves nothing, the
                 // search being local).
@@ -324,6 +334,17 @@ pub(super) fn count_search<'a>(
                 // capped greedy run of a narrow bend at 1000 fps): go on at the same count.
                 continue_tries += 1;
                 controls = c;
+            }
+            _ if best_capped && returns < max_returns && !planner.timed_out => {
+                // The count below the best line was not reached from it, but the stage that found that
+                // line stopped at its cap still improving: the line is not yet its count's best. Go on
+                // at its count from it, then try the count below again.
+                returns += 1;
+                best_capped = false;
+                if let Some(line) = &best {
+                    n = line.len();
+                    controls = line.clone();
+                }
             }
             _ => {
                 // With a line in hand the count below it is unreachable from it, unless the stage was
@@ -972,6 +993,66 @@ mod tests {
         assert!(capped_short && !full_short, "{ends:?}");
         assert!(capped_frames.is_some() && full_frames.is_some(), "{ends:?}");
         assert!(full_frames <= capped_frames, "{ends:?}");
+    }
+
+    #[test]
+    fn a_count_search_goes_back_to_a_line_its_capped_stage_left_still_improving() {
+        // The one-corner staircase from its greedy seed, five SCP iterations a count: stages stop at
+        // their cap still improving, and a count below the best line is not reached from it. The search
+        // then solves the best line's count again, from that line, before it gives the count below up;
+        // with no returns allowed it gives it up at once.
+        let scene = staircase_scene(1);
+        let (sim, bound, base) = planning_inputs(&scene);
+        let search = CountSearch::per_frame(Relaxation::certificate());
+        let searched = |capped_line_returns: usize| {
+            let settings = SearchSettings {
+                relaxed_iters: 5,
+                capped_line_returns,
+                ..SearchSettings::for_quality(Quality::Fast)
+            };
+            let budget = Budget::unlimited();
+            let mut planner = Planner::new(&scene, &sim, &settings, &bound, base.seed(), budget);
+            let warm = planner.warm_start(base.seed());
+            let n = warm.len();
+            let mut tried = Vec::new();
+            let d = count_search(
+                &mut planner,
+                &mut |p| {
+                    if let Progress::FrameCount { frames, reached } = p {
+                        tried.push((frames, reached));
+                    }
+                },
+                warm,
+                n,
+                0,
+                search,
+            );
+            let line = d.line.unwrap_or_else(|| panic!("no line: {tried:?}"));
+            // The line returned is the fastest any count reached.
+            let fastest = tried.iter().filter_map(|t| t.1).min();
+            assert_eq!(Some(line.len()), fastest, "{tried:?}");
+            tried
+        };
+        // A count not reached, below a line already found, followed by that line's own count.
+        let went_back = |tried: &[(usize, Option<usize>)]| {
+            tried.windows(2).enumerate().any(|(i, w)| {
+                let best_before = tried[..i].iter().filter_map(|t| t.1).min();
+                w[0].1.is_none() && best_before.is_some_and(|b| w[0].0 < b && w[1].0 == b)
+            })
+        };
+        let with_returns = searched(SearchSettings::for_quality(Quality::Fast).capped_line_returns);
+        assert!(went_back(&with_returns), "{with_returns:?}");
+        let without = searched(0);
+        assert!(!went_back(&without), "{without:?}");
+        // Without returns the search ends at the count below its line (continued at that count while
+        // its own stages stop at their cap).
+        let line = without.iter().filter_map(|t| t.1).min();
+        assert!(
+            without
+                .iter()
+                .all(|t| t.1.is_some() || Some(t.0 + 1) == line),
+            "{without:?}"
+        );
     }
 
     /// The frame counts a search reports (through `search`'s progress callback) as it tries them.

@@ -52,6 +52,10 @@ pub struct SearchSettings {
     pub relaxed_iters: u64,
     /// SCP iterations of the polishing stage.
     pub polish_iters: u64,
+    /// Times, at most, a search over frame counts goes back to its best line's count when the count
+    /// below it is not reached and the stage that found that line stopped at its iteration cap, still
+    /// improving (0: never; the count below is then given up at once).
+    pub capped_line_returns: usize,
     /// Times, at most, the fastest airborne plan is polished again from its own controls while it gets
     /// faster (0: never), each time in stages whose trust region regrows after a corrected step.
     pub final_polish_rounds: usize,
@@ -80,6 +84,7 @@ impl SearchSettings {
             margin_units: 0.02,
             relaxed_iters: 120,
             polish_iters: 40,
+            capped_line_returns: 3,
             final_polish_rounds: 3,
             tol_progress_units: 1e-6,
             slack_weight: 100.0,
