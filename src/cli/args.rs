@@ -112,6 +112,17 @@ pub enum SubProblemSolverArg {
     Clarabel,
 }
 
+impl QualityArg {
+    /// The library's level.
+    pub fn quality(self) -> crate::optimise::Quality {
+        match self {
+            QualityArg::Fast => crate::optimise::Quality::Fast,
+            QualityArg::Balanced => crate::optimise::Quality::Balanced,
+            QualityArg::Exact => crate::optimise::Quality::Exact,
+        }
+    }
+}
+
 impl SubProblemSolverArg {
     /// The library's solver.
     pub fn solver(self) -> crate::optimise::qp::SubProblemSolver {

@@ -94,15 +94,6 @@ pub fn search_settings(args: &BenchArgs, q: Quality) -> Result<SearchSettings> {
     Ok(settings)
 }
 
-/// The library's quality level.
-pub fn quality(q: QualityArg) -> Quality {
-    match q {
-        QualityArg::Fast => Quality::Fast,
-        QualityArg::Balanced => Quality::Balanced,
-        QualityArg::Exact => Quality::Exact,
-    }
-}
-
 /// The width of a `[bend90]` shorthand, if the file has one.
 fn bend_width(path: &Path) -> Option<f64> {
     let text = std::fs::read_to_string(path).ok()?;
@@ -143,7 +134,7 @@ pub fn run(args: &BenchArgs) -> Result<String> {
         settings.seed = seed;
     }
     if !args.levels.is_empty() {
-        let mut levels: Vec<Quality> = args.levels.iter().map(|&q| quality(q)).collect();
+        let mut levels: Vec<Quality> = args.levels.iter().map(|q| q.quality()).collect();
         levels.sort_by_key(|q| match q {
             Quality::Fast => 0,
             Quality::Balanced => 1,

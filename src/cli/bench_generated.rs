@@ -2,7 +2,8 @@
 //! the generated family ([`crate::bench::generated`]) and prints the distribution of each column, the
 //! share of scenes where greedy and the plan finished validly, and (`--json`) a record per scene.
 
-use super::bench::{quality, search_settings, BenchArgs};
+use super::args::QualityArg;
+use super::bench::{search_settings, BenchArgs};
 use super::gen::checked_count;
 use super::table::aligned_table;
 use crate::bench::generated::{
@@ -44,7 +45,7 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     }
     let settings = args.family.settings()?;
     let seed = args.seed.unwrap_or(DEFAULT_SEED);
-    let q = args.quality.map_or(Quality::Fast, quality);
+    let q = args.quality.map_or(Quality::Fast, QualityArg::quality);
     let search = search_settings(args, q)?;
     let scenes = generate_sample(seed, count, &settings)?;
     let show = std::io::stderr().is_terminal() && !args.json;

@@ -2,7 +2,8 @@
 //! corner count ([`crate::scene::generate::staircase`]) and prints one row per staircase, or (`--json`)
 //! one object with a record per staircase ([`crate::bench::generated::SceneRecord`]).
 
-use super::bench::{quality, BenchArgs};
+use super::args::QualityArg;
+use super::bench::BenchArgs;
 use super::bench_generated::progress_lines;
 use super::table::aligned_table;
 use crate::bench::generated::{measure_generated, SceneRecord};
@@ -37,7 +38,7 @@ pub fn run(args: &BenchArgs) -> Result<String> {
         .iter()
         .map(|&corners| staircase(&Staircase { corners, ..spec }))
         .collect::<Result<_>>()?;
-    let q = args.quality.map_or(Quality::Fast, quality);
+    let q = args.quality.map_or(Quality::Fast, QualityArg::quality);
     let search = super::bench::search_settings(args, q)?;
     let show = std::io::stderr().is_terminal() && !args.json && !args.quiet;
     let count = scenes.len() as u64;

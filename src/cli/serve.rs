@@ -1,9 +1,8 @@
 //! `strafeopt serve [SCENE]`: the planner page on a local port (see [`crate::serve`]).
 
-use super::args::{QualityArg, ServeArgs};
+use super::args::ServeArgs;
 use crate::error::{Error, Result};
 use crate::optimise::search::time_limit;
-use crate::optimise::Quality;
 use crate::scene::SceneEdit;
 use crate::serve::{ServeConfig, Server};
 use std::io::Write;
@@ -39,11 +38,7 @@ pub fn run(args: &ServeArgs) -> Result<String> {
         None => SceneEdit::from_toml_str(DEFAULT_SCENE, "hl-bend90-100fps.toml")?,
     };
     let bind = args.bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
-    let quality = match args.quality {
-        QualityArg::Fast => Quality::Fast,
-        QualityArg::Balanced => Quality::Balanced,
-        QualityArg::Exact => Quality::Exact,
-    };
+    let quality = args.quality.quality();
     let name = initial.name.clone();
     let server = Server::bind(ServeConfig {
         bind,

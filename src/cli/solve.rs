@@ -1,6 +1,6 @@
 //! `strafeopt solve`: the minimal-time plan of a scene, beside the greedy baseline and the lower bound.
 
-use super::args::{QualityArg, SolveArgs};
+use super::args::SolveArgs;
 use super::{progress, write_artifacts_within};
 use crate::budget::{Budget, Stage};
 use crate::error::{Error, Result};
@@ -12,11 +12,7 @@ use serde_json::{json, Value};
 /// Runs `solve` and returns what to print. No valid path: [`Error::NoValidPath`] (exit 3), nothing written.
 /// A scene that needs more frames than `--max-frames`: [`Error::FrameLimit`] (exit 2), before any work.
 pub fn run(args: &SolveArgs) -> Result<String> {
-    let quality = match args.quality {
-        QualityArg::Fast => Quality::Fast,
-        QualityArg::Balanced => Quality::Balanced,
-        QualityArg::Exact => Quality::Exact,
-    };
+    let quality = args.quality.quality();
     let mut settings = SearchSettings::for_quality(quality);
     if let Some(s) = args.time_limit {
         settings.time_limit = Some(time_limit(s)?);
