@@ -1002,7 +1002,6 @@ mod tests {
         // then solves the best line's count again, from that line, before it gives the count below up;
         // with no returns allowed it gives it up at once.
         let scene = staircase_scene(1);
-        let (sim, bound, base) = planning_inputs(&scene);
         let search = CountSearch::per_frame(Relaxation::certificate());
         let searched = |capped_line_returns: usize| {
             let settings = SearchSettings {
@@ -1010,28 +1009,19 @@ mod tests {
                 capped_line_returns,
                 ..SearchSettings::for_quality(Quality::Fast)
             };
-            let budget = Budget::unlimited();
-            let mut planner = Planner::new(&scene, &sim, &settings, &bound, base.seed(), budget);
-            let warm = planner.warm_start(base.seed());
-            let n = warm.len();
-            let mut tried = Vec::new();
-            let d = count_search(
-                &mut planner,
-                &mut |p| {
-                    if let Progress::FrameCount { frames, reached } = p {
-                        tried.push((frames, reached));
-                    }
-                },
-                warm,
-                n,
-                0,
-                search,
-            );
-            let line = d.line.unwrap_or_else(|| panic!("no line: {tried:?}"));
-            // The line returned is the fastest any count reached.
-            let fastest = tried.iter().filter_map(|t| t.1).min();
-            assert_eq!(Some(line.len()), fastest, "{tried:?}");
-            tried
+            with_planner(&scene, &settings, |planner, base, _| {
+                let warm = planner.warm_start(base.seed());
+                let n = warm.len();
+                let mut line = None;
+                let tried = counts_and_crossings(|record| {
+                    line = count_search(planner, record, warm, n, 0, search).line;
+                });
+                let line = line.unwrap_or_else(|| panic!("no line: {tried:?}"));
+                // The line returned is the fastest any count reached.
+                let fastest = tried.iter().filter_map(|t| t.1).min();
+                assert_eq!(Some(line.len()), fastest, "{tried:?}");
+                tried
+            })
         };
         // A count not reached, below a line already found, followed by that line's own count.
         let went_back = |tried: &[(usize, Option<usize>)]| {
@@ -1055,15 +1045,26 @@ mod tests {
         );
     }
 
-    /// The frame counts a search reports (through `search`'s progress callback) as it tries them.
-    fn counts_tried(search: impl FnOnce(&mut dyn FnMut(Progress))) -> Vec<usize> {
+    /// The frame counts a search reports (through `search`'s progress callback) as it tries them, each
+    /// with the frame its line crosses in where it reaches the line cleanly.
+    fn counts_and_crossings(
+        search: impl FnOnce(&mut dyn FnMut(Progress)),
+    ) -> Vec<(usize, Option<usize>)> {
         let mut counts = Vec::new();
         search(&mut |p| {
-            if let Progress::FrameCount { frames, .. } = p {
-                counts.push(frames);
+            if let Progress::FrameCount { frames, reached } = p {
+                counts.push((frames, reached));
             }
         });
         counts
+    }
+
+    /// The frame counts a search reports as it tries them ([`counts_and_crossings`]).
+    fn counts_tried(search: impl FnOnce(&mut dyn FnMut(Progress))) -> Vec<usize> {
+        counts_and_crossings(search)
+            .into_iter()
+            .map(|(frames, _)| frames)
+            .collect()
     }
 
     #[test]
