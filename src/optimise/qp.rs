@@ -17,6 +17,7 @@
 use super::lagrangian::CurvatureBlock;
 use super::model::FrameJacobian;
 use super::stagewise;
+pub(super) use super::stagewise::WarmStart;
 use crate::geometry::HalfPlane;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -124,6 +125,12 @@ pub struct SubStep {
     /// Per frame, the duals `z` of its dynamics rows `(px, py, V, psi)` (Clarabel's convention
     /// `P x + q + A' z = 0`), when solved: the next iteration's curvature weights.
     pub dynamics_duals: Vec<[f64; 4]>,
+    /// Where the frame-by-frame solver ended, when it solved the sub-problem: the start of the next
+    /// sub-problem of the same stage ([`solve_warm`]).
+    pub(super) warm_start: Option<stagewise::WarmStart>,
+    /// Interior-point iterations of the solve that gave the step (a failed attempt's before it not
+    /// counted); 0 when failed.
+    pub iterations: u32,
 }
 
 /// A control's allowed change at most this wide (scaled units) counts as none: the control is fixed.
@@ -138,6 +145,8 @@ impl SubStep {
             dp: vec![],
             predicted: 0.0,
             dynamics_duals: vec![],
+            warm_start: None,
+            iterations: 0,
         }
     }
 }
@@ -160,25 +169,51 @@ pub fn solve(sp: &SubProblem) -> SubStep {
 /// and then Clarabel's in the time left; infinite: no limit): a sub-problem cut short is a failed step,
 /// so the search's deadline holds inside one too.
 pub fn solve_within_time(sp: &SubProblem, time_limit_s: f64) -> SubStep {
-    solve_limited(sp, MAX_SUBPROBLEM_ITERATIONS, time_limit_s)
+    solve_limited(sp, MAX_SUBPROBLEM_ITERATIONS, time_limit_s, None)
+}
+
+/// [`solve_within_time`] with the frame-by-frame solver started where the last sub-problem of the stage
+/// ended (`warm`, its [`SubStep::warm_start`]). A warm solve that ends for its numerics or at the
+/// iteration cap is solved again from cold before Clarabel is asked.
+pub(super) fn solve_warm(
+    sp: &SubProblem,
+    time_limit_s: f64,
+    warm: Option<&stagewise::WarmStart>,
+) -> SubStep {
+    solve_limited(sp, MAX_SUBPROBLEM_ITERATIONS, time_limit_s, warm)
 }
 
 /// [`solve`] with the solvers' interior-point iteration cap given (tests force Clarabel's
 /// `MaxIterations` status with it).
 pub fn solve_capped(sp: &SubProblem, max_iterations: u32) -> SubStep {
-    solve_limited(sp, max_iterations, f64::INFINITY)
+    solve_limited(sp, max_iterations, f64::INFINITY, None)
 }
 
-/// [`solve`] with the iteration cap and time limit, seconds: by [`SubProblem::solver`], then by Clarabel
-/// where the frame-by-frame solver gives no solution.
-fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> SubStep {
+/// [`solve`] with the iteration cap and time limit, seconds, and the frame-by-frame solver's warm start:
+/// by [`SubProblem::solver`], then by Clarabel where the frame-by-frame solver gives no solution.
+fn solve_limited(
+    sp: &SubProblem,
+    max_iterations: u32,
+    time_limit_s: f64,
+    warm: Option<&stagewise::WarmStart>,
+) -> SubStep {
     let layout = Layout::of(sp);
     let rhs = wall_rhs(sp);
     let started = std::time::Instant::now();
     let staged = match sp.solver {
         SubProblemSolver::Riccati => {
             let problem = stagewise::StagedProblem::new(sp, &layout, &rhs);
-            match stagewise::solve(&problem, max_iterations, time_limit_s) {
+            let solved = stagewise::solve(&problem, max_iterations, time_limit_s, warm);
+            let solved = match solved {
+                Err(stagewise::NotStaged::Numerics | stagewise::NotStaged::MaxIterations)
+                    if warm.is_some() =>
+                {
+                    let left_s = time_limit_s - started.elapsed().as_secs_f64();
+                    stagewise::solve(&problem, max_iterations, left_s, None)
+                }
+                solved => solved,
+            };
+            match solved {
                 Ok(solution) => Some(solution),
                 // Clarabel would have no time left either: setting it up would be work after the
                 // deadline (on a run of thousands of frames, tenths of a second).
@@ -192,7 +227,12 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
     };
     if let Some(s) = staged {
         let status = SubStepStatus::Solved { almost: s.almost };
-        return sub_step_of(sp, &layout, status, s.x, s.dynamics_duals);
+        let step = sub_step_of(sp, &layout, status, s.x, s.dynamics_duals);
+        return SubStep {
+            warm_start: Some(s.warm_start),
+            iterations: s.iterations,
+            ..step
+        };
     }
     let left_s = time_limit_s - started.elapsed().as_secs_f64();
     match clarabel_solved(sp, &layout, &rhs, max_iterations, left_s) {
@@ -202,7 +242,11 @@ fn solve_limited(sp: &SubProblem, max_iterations: u32, time_limit_s: f64) -> Sub
             let duals = (0..layout.n_frames)
                 .map(|k| std::array::from_fn(|i| z.get(4 * k + i).copied().unwrap_or(0.0)))
                 .collect();
-            sub_step_of(sp, &layout, solution.status, solution.x, duals)
+            let step = sub_step_of(sp, &layout, solution.status, solution.x, duals);
+            SubStep {
+                iterations: solution.iterations,
+                ..step
+            }
         }
         Ok(_) => SubStep::failed(SubStepStatus::Failed("solution of the wrong size".into())),
         Err(no) => SubStep::failed(SubStepStatus::Failed(no.to_string())),
@@ -489,6 +533,8 @@ fn sub_step_of(
         dp,
         predicted,
         dynamics_duals,
+        warm_start: None,
+        iterations: 0,
     }
 }
 
@@ -535,6 +581,7 @@ struct Solution {
     status: SubStepStatus,
     x: Vec<f64>,
     z: Vec<f64>,
+    iterations: u32,
 }
 
 /// Why Clarabel gave no usable solution.
@@ -640,6 +687,7 @@ fn clarabel_run(
         status,
         x,
         z: std::mem::take(&mut solver.solution.z),
+        iterations: solver.info.iterations,
     })
 }
 
@@ -1047,6 +1095,65 @@ mod tests {
         chain
     }
 
+    /// `sp` laid out and solved frame by frame, from `warm` if given.
+    fn solved_frame_by_frame(
+        sp: &SubProblem,
+        warm: Option<&WarmStart>,
+    ) -> stagewise::StagedSolution {
+        let layout = Layout::of(sp);
+        let rhs = wall_rhs(sp);
+        let problem = stagewise::StagedProblem::new(sp, &layout, &rhs);
+        let solved = stagewise::solve(&problem, MAX_SUBPROBLEM_ITERATIONS, 10.0, warm);
+        solved.unwrap_or_else(|e| panic!("{e:?}"))
+    }
+
+    #[test]
+    fn a_sub_problem_started_where_its_neighbour_ended_reaches_the_same_step_in_fewer_iterations() {
+        // The SCP's next sub-problem after a rejected step: the same linearisation, the trust region
+        // cut to a third. Started from where the first one ended, the solver must reach the step it
+        // reaches from cold (the optimum's value is unique) and take fewer iterations over the cases:
+        // a warm start that is not applied, or applied to the wrong rows, takes as many or more.
+        let mut s = Stream(20261129);
+        let (mut cold_iterations, mut warm_iterations) = (0, 0);
+        for case in 0..40 {
+            let c = random_chain(&mut s);
+            let mut sp = SubProblem {
+                jacobians: &c.jacobians,
+                positions: &c.positions,
+                walls: &c.walls,
+                margin: 0.0,
+                accepted_clearance: 0.0,
+                slack_weight: 100.0,
+                progress_dir: Vec2::new(0.8, 0.6),
+                sigma_range: &c.sigma_range,
+                c_range: &c.c_range,
+                curvature: c.curvature.as_deref(),
+                wall_shift: None,
+                solver: SubProblemSolver::Riccati,
+            };
+            let first = solved_frame_by_frame(&sp, None);
+            let third = |r: &[(f64, f64)]| r.iter().map(|(lo, hi)| (lo / 3.0, hi / 3.0)).collect();
+            let (sigma_range, c_range): (Vec<_>, Vec<_>) =
+                (third(&c.sigma_range), third(&c.c_range));
+            sp.sigma_range = &sigma_range;
+            sp.c_range = &c_range;
+            let cold = solved_frame_by_frame(&sp, None);
+            let warm = solved_frame_by_frame(&sp, Some(&first.warm_start));
+            let layout = Layout::of(&sp);
+            let [cold_gain, warm_gain] = [&cold, &warm].map(|s| predicted_gain(&sp, &layout, &s.x));
+            assert!(
+                (cold_gain - warm_gain).abs() < 1e-5 * (1.0 + cold_gain.abs()),
+                "case {case}: predicted {warm_gain} warm against {cold_gain} cold"
+            );
+            cold_iterations += cold.iterations;
+            warm_iterations += warm.iterations;
+        }
+        assert!(
+            warm_iterations < cold_iterations,
+            "{warm_iterations} iterations warm against {cold_iterations} cold"
+        );
+    }
+
     #[test]
     fn both_solvers_find_the_same_step_on_random_chains_of_frames() {
         // The same convex QP: the optimum's value is unique, and with strictly convex curvature so are
@@ -1076,6 +1183,7 @@ mod tests {
                 &stagewise::StagedProblem::new(&sp, &layout, &rhs),
                 MAX_SUBPROBLEM_ITERATIONS,
                 10.0,
+                None,
             );
             assert!(staged.is_ok(), "case {case}: {:?}", staged.err());
             let [riccati, clarabel] = by_each_solver(&sp);

@@ -111,6 +111,19 @@ impl ScpProblem<'_> {
         violation
     }
 
+    /// Whether a sub-problem starts where the stage's last one ended ([`qp::solve_warm`]): with the sides
+    /// fixed, not in the relaxed problem. With its sides fixed a plan moves off a wall only through `c`,
+    /// and the interior-point method crawls from cold (docs/design.md, "Why a fixed-side sub-problem
+    /// takes three times the interior-point iterations of a relaxed one"), and a warm start saves a
+    /// third of them. An interior-point solve from cold ends near the centre of the face of optima its
+    /// tolerances leave open (sides the progress hardly depends on, inside their box), a warm-started
+    /// one near where the last solution was. Warm-started relaxed stages descended to other lines, and on
+    /// scenes of two CI-sized families the plans rounded from them were one to seven frames slower
+    /// (docs/design.md, "A warm start for the sub-problems").
+    fn warm_started(&self) -> bool {
+        !self.relaxed
+    }
+
     /// The trajectory of `controls`, its Jacobians and wall rows, and with `duals` (one per frame, from
     /// the last sub-problem) the convexified curvature of the Lagrangian ([`super::lagrangian`]).
     fn linearise(&self, controls: &[FrameControl], duals: Option<&[[f64; 4]]>) -> Linearised {
@@ -318,6 +331,9 @@ pub struct ScpSolver<'c> {
     stats: SearchStats,
     /// Dynamics duals of the last solved sub-problem, per frame: the curvature weights.
     duals: Option<Vec<[f64; 4]>>,
+    /// Where the frame-by-frame solver ended on the last solved sub-problem: the next one starts there
+    /// ([`qp::solve_warm`]).
+    warm_start: Option<qp::WarmStart>,
     /// The share of the Lagrangian's curvature the sub-problems carry, in `[MIN_CURVATURE_SHARE, 1]`
     /// (see [`OVERCURVED_RATIO`]).
     curvature_share: f64,
@@ -342,6 +358,7 @@ impl<'c> ScpSolver<'c> {
             converged: false,
             stats: SearchStats::default(),
             duals: None,
+            warm_start: None,
             curvature_share: 1.0,
             restored_last: false,
             costs: Vec::new(),
@@ -469,14 +486,18 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let lz = problem.problem("linearise", |pr| {
             Ok(pr.linearisation(&controls, duals.as_deref(), trust, upper_at_kink))
         })?;
-        let step = problem.problem("solve", |pr| {
-            Ok(qp::solve_within_time(
+        let warm = self.warm_start.take();
+        let mut step = problem.problem("solve", |pr| {
+            Ok(qp::solve_warm(
                 &pr.sub_problem(&lz, None),
                 seconds_left,
+                warm.as_ref().filter(|_| pr.warm_started()),
             ))
         })?;
+        self.warm_start = step.warm_start.take().or(warm);
         self.stats.iterations += 1;
         self.stats.subproblems += 1;
+        self.stats.interior_point_iterations += u64::from(step.iterations);
         let du = match step.status {
             SubStepStatus::Solved { .. } => {
                 self.duals = Some(step.dynamics_duals);
@@ -592,15 +613,20 @@ impl ScpSolver<'_> {
                 .zip(step_dp)
                 .map(|((t, p), dp)| t.pos - (*p + *dp))
                 .collect();
-            Ok(Some(qp::solve_within_time(
+            Ok(Some(qp::solve_warm(
                 &pr.sub_problem(lz, Some(&left_out)),
                 seconds_left,
+                self.warm_start.as_ref().filter(|_| pr.warm_started()),
             )))
         })?;
-        let Some(corrected) = corrected else {
+        let Some(mut corrected) = corrected else {
             return Ok(None);
         };
+        if let Some(warm) = corrected.warm_start.take() {
+            self.warm_start = Some(warm);
+        }
         self.stats.subproblems += 1;
+        self.stats.interior_point_iterations += u64::from(corrected.iterations);
         if !matches!(corrected.status, SubStepStatus::Solved { .. }) {
             self.stats.subproblem_failures += 1;
             return Ok(None);

@@ -202,6 +202,8 @@ pub struct SearchStats {
     pub subproblems: u64,
     /// Sub-problems Clarabel could not solve (trust region shrunk).
     pub subproblem_failures: u64,
+    /// Interior-point iterations of the solved sub-problems, by either solver.
+    pub interior_point_iterations: u64,
     /// Steps rejected by exact re-simulation, their second-order correction too.
     pub rejected_steps: u64,
     /// Steps rejected by exact re-simulation but kept after a second-order correction (each such
@@ -224,6 +226,7 @@ impl SearchStats {
         self.iterations += other.iterations;
         self.subproblems += other.subproblems;
         self.subproblem_failures += other.subproblem_failures;
+        self.interior_point_iterations += other.interior_point_iterations;
         self.rejected_steps += other.rejected_steps;
         self.corrected_steps += other.corrected_steps;
         self.frame_counts_tried += other.frame_counts_tried;

@@ -16,6 +16,12 @@
 //! forward pass the step. The rows' residuals `G z + t - h` start where the first iterate puts them
 //! ([`started`]) and shrink by `1 - alpha` with every step of length `alpha` (the rows are linear), so
 //! they are tracked, not recomputed, until the tolerances are checked.
+//!
+//! A sub-problem of an SCP stage is the last one linearised about a trajectory a step away, or the same
+//! one with its wall rows moved: its rows are where they were, and most are as active or as loose as
+//! they were. So the last solution's slacks and duals ([`WarmStart`]) can start the next solve, each
+//! lifted to at least [`WARM_START_FLOOR`]: the first steps then need not find again which rows are
+//! active. The SCP asks for it in its stages with the sides fixed (`ScpProblem::warm_started`).
 
 use super::qp::{
     control_scale, Layout, SubProblem, CONTROL_REGULARISATION, SUBPROBLEM_FEAS_TOL,
@@ -48,6 +54,22 @@ impl<'a> StagedProblem<'a> {
     }
 }
 
+/// Where a solve ended, to start the next one of the same chain: per frame its number of rows, and per
+/// row its slack and dual.
+#[derive(Clone, Debug)]
+pub struct WarmStart {
+    rows_per_frame: Vec<usize>,
+    t: Vec<f64>,
+    lambda: Vec<f64>,
+}
+
+/// A warm start's slacks and duals are lifted to at least this. Left at the last solution's
+/// complementarity (`t lambda` near 1e-11), a row active there but loose now blocks the steps until its
+/// pair has grown back by orders of magnitude; lifted much less, warm starts fail for their numerics;
+/// lifted much more, they start as far from the solution as a cold start (docs/design.md, "A warm
+/// start for the sub-problems").
+const WARM_START_FLOOR: f64 = 0.1;
+
 /// A solution in Clarabel's layout: the primal `x` and, per frame, the duals of its dynamics rows in
 /// Clarabel's convention (`P x + q + A' z = 0`).
 pub(super) struct StagedSolution {
@@ -57,6 +79,10 @@ pub(super) struct StagedSolution {
     pub dynamics_duals: Vec<[f64; 4]>,
     /// Met only the looser tolerances.
     pub almost: bool,
+    /// The last iterate, to start the next sub-problem from.
+    pub warm_start: WarmStart,
+    /// Interior-point iterations taken.
+    pub iterations: u32,
 }
 
 /// Why the frame-by-frame solver gave no solution (the caller then asks Clarabel).
@@ -324,10 +350,14 @@ struct Direction {
 /// relative to the largest right-hand side (the tolerances of [`super::qp`]). The gap is absolute: the
 /// objective carries the weighted violation the trust region cannot remove (thousands of units where a
 /// start is far inside a wall), and a gap relative to it left a control 5e-4 short of its bound.
+///
+/// With `warm`, the slacks and duals of each frame with as many rows as there start from there (see
+/// [`WarmStart`]); the other frames', and every primal variable, start as from cold.
 pub(super) fn solve(
     p: &StagedProblem,
     max_iterations: u32,
     time_limit_s: f64,
+    warm: Option<&WarmStart>,
 ) -> Result<StagedSolution, NotStaged> {
     let clock = std::time::Instant::now();
     let (frames, wall_rows) = frames_of(p)?;
@@ -340,21 +370,28 @@ pub(super) fn solve(
         })
         .collect();
     let mut it = started(p, &frames, &offsets)?;
+    if let Some(warm) = warm {
+        warm_started(&frames, &offsets, &mut it, warm);
+    }
     let tolerances = Tolerances::of(p, &frames);
     let mut almost = false;
-    for _ in 0..max_iterations {
+    let solved_after = |iterations: u32, it: &Iterate, almost: bool| StagedSolution {
+        iterations,
+        ..solution(p, &frames, &wall_rows, &offsets, it, almost)
+    };
+    for iteration in 0..max_iterations {
         if clock.elapsed().as_secs_f64() > time_limit_s {
             return Err(NotStaged::TimeLimit);
         }
         match tolerances.met(p, &frames, &offsets, &it) {
-            Met::Solved => return Ok(solution(p, &frames, &wall_rows, &offsets, &it, false)),
+            Met::Solved => return Ok(solved_after(iteration, &it, false)),
             Met::Almost => almost = true,
             Met::Not => almost = false,
         }
         mehrotra_step(p, &frames, &offsets, &mut it)?;
     }
     if almost {
-        return Ok(solution(p, &frames, &wall_rows, &offsets, &it, true));
+        return Ok(solved_after(max_iterations, &it, true));
     }
     Err(NotStaged::MaxIterations)
 }
@@ -462,6 +499,26 @@ fn started(p: &StagedProblem, frames: &[Frame], offsets: &[usize]) -> Result<Ite
     }
     it.rp = primal_residual(frames, offsets, &it);
     Ok(it)
+}
+
+/// `it` with the slacks and duals of `warm` (lifted to [`WARM_START_FLOOR`]) on every frame that has as
+/// many rows as it had there, its rows' residuals measured again; unchanged if the frames differ in
+/// number.
+fn warm_started(frames: &[Frame], offsets: &[usize], it: &mut Iterate, warm: &WarmStart) {
+    if warm.rows_per_frame.len() != frames.len() {
+        return;
+    }
+    let mut at = 0;
+    for ((f, &o), &rows) in frames.iter().zip(offsets).zip(&warm.rows_per_frame) {
+        if f.rows.len() == rows {
+            for i in 0..rows {
+                it.t[o + i] = warm.t[at + i].max(WARM_START_FLOOR);
+                it.lambda[o + i] = warm.lambda[at + i].max(WARM_START_FLOOR);
+            }
+        }
+        at += rows;
+    }
+    it.rp = primal_residual(frames, offsets, it);
 }
 
 /// Per row, `G z + t - h`.
@@ -763,7 +820,8 @@ fn cholesky_solve(
 /// The iterate in Clarabel's layout, with the duals of the dynamics rows: `z_k = -a_k`, `a_k` the
 /// gradient of the Lagrangian in the state change after frame `k` through all later frames (its
 /// direct terms: the next frame's curvature, the last frame's progress and the wall rows of frame `k`'s
-/// end, which the frames hold through their dynamics and so are added back here).
+/// end, which the frames hold through their dynamics and so are added back here). Its iteration count
+/// is the caller's to fill in.
 fn solution(
     p: &StagedProblem,
     frames: &[Frame],
@@ -822,6 +880,12 @@ fn solution(
         x,
         dynamics_duals: duals,
         almost,
+        warm_start: WarmStart {
+            rows_per_frame: frames.iter().map(|f| f.rows.len()).collect(),
+            t: it.t.clone(),
+            lambda: it.lambda.clone(),
+        },
+        iterations: 0,
     }
 }
 
@@ -861,7 +925,12 @@ mod tests {
         };
         let layout = Layout::of(&sp);
         let rhs = vec![0.5; walls.len()];
-        solve(&StagedProblem::new(&sp, &layout, &rhs), 100, time_limit_s)
+        solve(
+            &StagedProblem::new(&sp, &layout, &rhs),
+            100,
+            time_limit_s,
+            None,
+        )
     }
 
     /// A wall keeping the end position at `y <= 0.5` (the row `-n . dp - s <= 0.5`, `n = (0, -1)`).
