@@ -114,12 +114,13 @@ impl ScpProblem<'_> {
     /// Whether a sub-problem starts where the stage's last one ended ([`qp::solve_warm`]): with the sides
     /// fixed, not in the relaxed problem. With its sides fixed a plan moves off a wall only through `c`,
     /// and the interior-point method crawls from cold (docs/design.md, "Why a fixed-side sub-problem
-    /// takes three times the interior-point iterations of a relaxed one"), and a warm start saves a
-    /// third of them. An interior-point solve from cold ends near the centre of the face of optima its
-    /// tolerances leave open (sides the progress hardly depends on, inside their box), a warm-started
-    /// one near where the last solution was. Warm-started relaxed stages descended to other lines, and on
-    /// scenes of two CI-sized families the plans rounded from them were one to seven frames slower
-    /// (docs/design.md, "A warm start for the sub-problems").
+    /// takes three times the interior-point iterations of a relaxed one"); started where the last
+    /// solution ended, it need not find again which rows are active. An interior-point solve from cold
+    /// ends near the centre of the face of optima its tolerances leave open (sides the progress hardly
+    /// depends on, inside their box), a warm-started one near where the last solution was.
+    /// Warm-started relaxed stages descended to other lines, and on scenes of two CI-sized families the
+    /// plans rounded from them were one to seven frames slower (docs/design.md, "A warm start for the
+    /// sub-problems").
     fn warm_started(&self) -> bool {
         !self.relaxed
     }
