@@ -1023,6 +1023,26 @@ mod tests {
         curvature: Option<Vec<CurvatureBlock>>,
     }
 
+    impl RandomChain {
+        /// The chain as a sub-problem for the frame-by-frame solver, progress along `(0.8, 0.6)`.
+        fn sub_problem(&self) -> SubProblem<'_> {
+            SubProblem {
+                jacobians: &self.jacobians,
+                positions: &self.positions,
+                walls: &self.walls,
+                margin: 0.0,
+                accepted_clearance: 0.0,
+                slack_weight: 100.0,
+                progress_dir: Vec2::new(0.8, 0.6),
+                sigma_range: &self.sigma_range,
+                c_range: &self.c_range,
+                curvature: self.curvature.as_deref(),
+                wall_shift: None,
+                solver: SubProblemSolver::Riccati,
+            }
+        }
+    }
+
     fn random_chain(s: &mut Stream) -> RandomChain {
         let n = 1 + (s.next() * 60.0) as usize;
         let mut chain = RandomChain {
@@ -1117,20 +1137,7 @@ mod tests {
         let (mut cold_iterations, mut warm_iterations) = (0, 0);
         for case in 0..40 {
             let c = random_chain(&mut s);
-            let mut sp = SubProblem {
-                jacobians: &c.jacobians,
-                positions: &c.positions,
-                walls: &c.walls,
-                margin: 0.0,
-                accepted_clearance: 0.0,
-                slack_weight: 100.0,
-                progress_dir: Vec2::new(0.8, 0.6),
-                sigma_range: &c.sigma_range,
-                c_range: &c.c_range,
-                curvature: c.curvature.as_deref(),
-                wall_shift: None,
-                solver: SubProblemSolver::Riccati,
-            };
+            let mut sp = c.sub_problem();
             let first = solved_frame_by_frame(&sp, None);
             let third = |r: &[(f64, f64)]| r.iter().map(|(lo, hi)| (lo / 3.0, hi / 3.0)).collect();
             let (sigma_range, c_range): (Vec<_>, Vec<_>) =
@@ -1163,20 +1170,7 @@ mod tests {
         let mut compared = 0;
         for case in 0..60 {
             let c = random_chain(&mut s);
-            let sp = SubProblem {
-                jacobians: &c.jacobians,
-                positions: &c.positions,
-                walls: &c.walls,
-                margin: 0.0,
-                accepted_clearance: 0.0,
-                slack_weight: 100.0,
-                progress_dir: Vec2::new(0.8, 0.6),
-                sigma_range: &c.sigma_range,
-                c_range: &c.c_range,
-                curvature: c.curvature.as_deref(),
-                wall_shift: None,
-                solver: SubProblemSolver::Riccati,
-            };
+            let sp = c.sub_problem();
             let layout = Layout::of(&sp);
             let rhs = wall_rhs(&sp);
             let staged = stagewise::solve(
