@@ -127,7 +127,7 @@ pub struct SubStep {
     pub dynamics_duals: Vec<[f64; 4]>,
     /// Where the frame-by-frame solver ended, when it solved the sub-problem: the start of the next
     /// sub-problem of the same stage ([`solve_warm`]).
-    pub(super) warm_start: Option<stagewise::WarmStart>,
+    pub(super) warm_start: Option<WarmStart>,
     /// Interior-point iterations of the solve that gave the step (a failed attempt's before it not
     /// counted); 0 when failed.
     pub iterations: u32,
@@ -175,11 +175,7 @@ pub fn solve_within_time(sp: &SubProblem, time_limit_s: f64) -> SubStep {
 /// [`solve_within_time`] with the frame-by-frame solver started where the last sub-problem of the stage
 /// ended (`warm`, its [`SubStep::warm_start`]). A warm solve that ends for its numerics or at the
 /// iteration cap is solved again from cold before Clarabel is asked.
-pub(super) fn solve_warm(
-    sp: &SubProblem,
-    time_limit_s: f64,
-    warm: Option<&stagewise::WarmStart>,
-) -> SubStep {
+pub(super) fn solve_warm(sp: &SubProblem, time_limit_s: f64, warm: Option<&WarmStart>) -> SubStep {
     solve_limited(sp, MAX_SUBPROBLEM_ITERATIONS, time_limit_s, warm)
 }
 
@@ -195,7 +191,7 @@ fn solve_limited(
     sp: &SubProblem,
     max_iterations: u32,
     time_limit_s: f64,
-    warm: Option<&stagewise::WarmStart>,
+    warm: Option<&WarmStart>,
 ) -> SubStep {
     let layout = Layout::of(sp);
     let rhs = wall_rhs(sp);

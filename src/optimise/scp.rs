@@ -487,15 +487,14 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let lz = problem.problem("linearise", |pr| {
             Ok(pr.linearisation(&controls, duals.as_deref(), trust, upper_at_kink))
         })?;
-        let warm = self.warm_start.take();
         let mut step = problem.problem("solve", |pr| {
             Ok(qp::solve_warm(
                 &pr.sub_problem(&lz, None),
                 seconds_left,
-                warm.as_ref().filter(|_| pr.warm_started()),
+                self.warm_start.as_ref().filter(|_| pr.warm_started()),
             ))
         })?;
-        self.warm_start = step.warm_start.take().or(warm);
+        self.keep_warm_start(&mut step);
         self.stats.iterations += 1;
         self.stats.subproblems += 1;
         self.stats.interior_point_iterations += u64::from(step.iterations);
@@ -585,6 +584,13 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
 }
 
 impl ScpSolver<'_> {
+    /// Where `step`'s solver ended, if it says, as the start of the next sub-problem.
+    fn keep_warm_start(&mut self, step: &mut qp::SubStep) {
+        if let Some(warm) = step.warm_start.take() {
+            self.warm_start = Some(warm);
+        }
+    }
+
     /// The second-order correction of a rejected step (Nocedal and Wright, section 18.3): the linearised
     /// dynamics leave out the second-order change of the positions, which along hundreds of frames adds up
     /// to units, so a step that the sub-problem kept clear can land in a wall, and the merit charges that
@@ -623,9 +629,7 @@ impl ScpSolver<'_> {
         let Some(mut corrected) = corrected else {
             return Ok(None);
         };
-        if let Some(warm) = corrected.warm_start.take() {
-            self.warm_start = Some(warm);
-        }
+        self.keep_warm_start(&mut corrected);
         self.stats.subproblems += 1;
         self.stats.interior_point_iterations += u64::from(corrected.iterations);
         if !matches!(corrected.status, SubStepStatus::Solved { .. }) {

@@ -70,6 +70,17 @@ pub struct WarmStart {
 /// start for the sub-problems").
 const WARM_START_FLOOR: f64 = 0.1;
 
+impl WarmStart {
+    /// Whether it holds the slacks and duals of every frame of `frames` (each with as many rows).
+    fn covers(&self, frames: &[Frame]) -> bool {
+        self.rows_per_frame.len() == frames.len()
+            && frames
+                .iter()
+                .zip(&self.rows_per_frame)
+                .all(|(f, &rows)| f.rows.len() == rows)
+    }
+}
+
 /// A solution in Clarabel's layout: the primal `x` and, per frame, the duals of its dynamics rows in
 /// Clarabel's convention (`P x + q + A' z = 0`).
 pub(super) struct StagedSolution {
@@ -369,13 +380,18 @@ pub(super) fn solve(
             Some(o)
         })
         .collect();
-    let mut it = started(p, &frames, &offsets)?;
+    let mut it = match warm {
+        // Every frame's slacks and duals come from the warm start: the cold start's affine step would
+        // be overwritten.
+        Some(warm) if warm.covers(&frames) => centred(&frames),
+        _ => started(p, &frames, &offsets)?,
+    };
     if let Some(warm) = warm {
         warm_started(&frames, &offsets, &mut it, warm);
     }
     let tolerances = Tolerances::of(p, &frames);
     let mut almost = false;
-    let solved_after = |iterations: u32, it: &Iterate, almost: bool| StagedSolution {
+    let solved_after = |iterations: u32, it: Iterate, almost: bool| StagedSolution {
         iterations,
         ..solution(p, &frames, &wall_rows, &offsets, it, almost)
     };
@@ -384,14 +400,14 @@ pub(super) fn solve(
             return Err(NotStaged::TimeLimit);
         }
         match tolerances.met(p, &frames, &offsets, &it) {
-            Met::Solved => return Ok(solved_after(iteration, &it, false)),
+            Met::Solved => return Ok(solved_after(iteration, it, false)),
             Met::Almost => almost = true,
             Met::Not => almost = false,
         }
         mehrotra_step(p, &frames, &offsets, &mut it)?;
     }
     if almost {
-        return Ok(solved_after(max_iterations, &it, true));
+        return Ok(solved_after(max_iterations, it, true));
     }
     Err(NotStaged::MaxIterations)
 }
@@ -827,7 +843,7 @@ fn solution(
     frames: &[Frame],
     wall_rows: &[RowAt],
     offsets: &[usize],
-    it: &Iterate,
+    it: Iterate,
     almost: bool,
 ) -> StagedSolution {
     let n = frames.len();
@@ -882,8 +898,8 @@ fn solution(
         almost,
         warm_start: WarmStart {
             rows_per_frame: frames.iter().map(|f| f.rows.len()).collect(),
-            t: it.t.clone(),
-            lambda: it.lambda.clone(),
+            t: it.t,
+            lambda: it.lambda,
         },
         iterations: 0,
     }
