@@ -27,6 +27,6 @@ pub use bound::{lower_bound, LowerBound};
 pub use policy_run::PolicyRun;
 pub use relaxed::{RelaxedCertificate, CERTIFIED_CLEARANCE_UNITS};
 pub use search::{
-    solve, solve_cancellable, solve_with_progress, Outcome, Progress, Quality, SearchSettings,
-    SearchStatus,
+    solve, solve_cancellable, solve_with_progress, FinePolish, Outcome, Progress, Quality,
+    SearchSettings, SearchStatus,
 };

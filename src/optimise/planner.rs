@@ -108,6 +108,17 @@ impl<'a> Planner<'a> {
         }
     }
 
+    /// A [`Planner::fork`] at other `settings`, for a stage run at settings of its own on this thread.
+    pub(super) fn fork_with<'b>(&self, settings: &'b SearchSettings) -> Planner<'b>
+    where
+        'a: 'b,
+    {
+        Planner {
+            settings,
+            ..self.fork()
+        }
+    }
+
     /// Adds the work of a [`Planner::fork`] done, and whether the budget cut it.
     pub(super) fn join(&mut self, forked: &Planner) {
         self.stats.add(&forked.stats);

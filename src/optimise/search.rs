@@ -13,7 +13,7 @@
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
-use super::airborne::plan_airborne;
+use super::airborne::{plan_airborne, plan_polished_finely};
 use super::baseline::{baseline, corner_caps, given_up_frame, GreedyGuide, GuideRun};
 use super::bound::{frame_limited_scene, lower_bound_within};
 use super::planner::Planner;
@@ -37,8 +37,22 @@ pub enum Quality {
     Fast,
     /// Relaxed, rounded, polished.
     Balanced,
-    /// As balanced with tight tolerances and more iterations.
+    /// Balanced, its fastest plan then polished on at half the wall margin with tight tolerances and
+    /// more iterations ([`FinePolish`]).
     Exact,
+}
+
+/// A last polish of the fastest plan, after the final polish, at a finer wall margin and tolerance than
+/// the search before it (`exact`'s): the plan is polished on from its own controls, and a plan is kept
+/// only where it is faster, so the level that has it is never slower than the same level without it.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct FinePolish {
+    /// Wall margin of the polished plan, units.
+    pub margin_units: f64,
+    /// SCP iterations of each of its stages.
+    pub polish_iters: u64,
+    /// Stop when the predicted improvement is below this, units of progress.
+    pub tol_progress_units: f64,
 }
 
 /// Settings of the search, with their units. `Default` is `balanced`.
@@ -74,6 +88,8 @@ pub struct SearchSettings {
     pub max_frames: u64,
     /// The solver each convexified sub-step is given first.
     pub sub_problem_solver: SubProblemSolver,
+    /// The last polish of the fastest airborne plan at finer settings, if any (`exact`'s).
+    pub fine_polish: Option<FinePolish>,
 }
 
 impl SearchSettings {
@@ -93,6 +109,7 @@ impl SearchSettings {
             time_limit: None,
             max_frames: crate::budget::DEFAULT_MAX_PLANNED_FRAMES,
             sub_problem_solver: SubProblemSolver::default(),
+            fine_polish: None,
         };
         match quality {
             Quality::Fast => SearchSettings {
@@ -104,11 +121,11 @@ impl SearchSettings {
             },
             Quality::Balanced => base,
             Quality::Exact => SearchSettings {
-                margin_units: 0.01,
-                relaxed_iters: 150,
-                polish_iters: 120,
-                tol_progress_units: 1e-9,
-                certificate_starts: 4,
+                fine_polish: Some(FinePolish {
+                    margin_units: 0.01,
+                    polish_iters: 120,
+                    tol_progress_units: 1e-9,
+                }),
                 ..base
             },
         }
@@ -291,12 +308,12 @@ pub fn solve(scene: &Scene, settings: &SearchSettings) -> Result<Outcome> {
 
 /// [`solve`], reporting what it does to `progress`.
 ///
-/// On airborne scenes a level first runs the levels below it, cheapest first (`exact`: `fast`, then
-/// `balanced`; `balanced`: `fast`), then itself in the time left, and keeps the fastest valid plan, so a
-/// higher level is never worse than a lower one, and a time limit that cuts it leaves the plan of a
-/// cheaper level rather than the greedy run. The levels differ in margin and tolerances and so can end in
-/// different local optima, or, in a corridor little wider than the hull, with no plan that survives
-/// rounding at the tighter margin.
+/// On airborne scenes `balanced` and `exact` first run `fast`, then themselves in the time left, and keep
+/// the fastest valid plan, so a higher level is never worse than `fast`, and a time limit that cuts it
+/// leaves `fast`'s plan rather than the greedy run. `exact` is `balanced`'s search with its fastest plan
+/// polished on at half the wall margin ([`FinePolish`]), which keeps a plan only where it is faster: it is
+/// never slower than `balanced`. The two searches differ in iterations and tolerances and so can end in
+/// different local optima.
 pub fn solve_with_progress(
     scene: &Scene,
     settings: &SearchSettings,
@@ -337,12 +354,12 @@ fn solve_within(
 ) -> Result<Outcome> {
     let started = Instant::now();
     if !scene.effects.is_air_only() {
-        return solve_once(scene, settings, budget, progress);
+        return solve_once(scene, settings, budget, progress, None);
     }
     let mut runs = level_runs(settings);
     // Never empty: it ends with the requested level.
     let first = runs.remove(0);
-    let mut best = solve_once(scene, &first, budget, progress)?;
+    let mut best = solve_once(scene, &first, budget, progress, None)?;
     let mut stats = best.stats;
     for level in runs {
         if budget.expired() {
@@ -352,7 +369,8 @@ fn solve_within(
             }
             break;
         }
-        let other = match solve_once(scene, &level, budget, progress) {
+        let below = (best.source == "optimised").then_some(&best.trace);
+        let other = match solve_once(scene, &level, budget, progress, below) {
             // A level cut before it had anything valid leaves the plan already found.
             Err(Error::Stopped { stage, .. }) => {
                 if best.status.stopped_in().is_none() {
@@ -399,8 +417,7 @@ fn level_runs(settings: &SearchSettings) -> Vec<SearchSettings> {
 fn levels_below(quality: Quality) -> &'static [Quality] {
     match quality {
         Quality::Fast => &[],
-        Quality::Balanced => &[Quality::Fast],
-        Quality::Exact => &[Quality::Fast, Quality::Balanced],
+        Quality::Balanced | Quality::Exact => &[Quality::Fast],
     }
 }
 
@@ -457,12 +474,14 @@ impl Finisher<'_> {
 }
 
 /// One run of the search at `settings` within `budget` (see [`solve_with_progress`]): the stages of the
-/// module documentation in order.
+/// module documentation in order. `below` is the fastest plan of the levels run before this one, which
+/// the fine polish ([`FinePolish`]) starts from where it is faster than this run's own.
 fn solve_once(
     scene: &Scene,
     settings: &SearchSettings,
     budget: Budget,
     progress: &mut dyn FnMut(Progress),
+    below: Option<&Trace>,
 ) -> Result<Outcome> {
     let started = Instant::now();
     let bound = lower_bound_within(scene, &scene.corridor()?, &budget)?;
@@ -507,7 +526,19 @@ fn solve_once(
     // No plan crosses before the bound's frame.
     let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
     // Stages 2 to 4.
-    let found = plan_airborne(&mut planner, &base, warm, n, lo, time_of(greedy), progress);
+    let greedy_s = time_of(greedy);
+    let mut found = plan_airborne(&mut planner, &base, warm, n, lo, greedy_s, progress);
+    if let Some(fine) = settings.fine_polish {
+        plan_polished_finely(
+            &mut planner,
+            &mut found,
+            fine,
+            below,
+            greedy_s,
+            lo,
+            progress,
+        );
+    }
     let stats = planner.stats;
     let stopped = planner
         .cut_in
@@ -607,7 +638,7 @@ mod tests {
         };
         let runs = level_runs(&settings);
         let levels: Vec<Quality> = runs.iter().map(|r| r.quality).collect();
-        assert_eq!(levels, [Quality::Fast, Quality::Balanced, Quality::Exact]);
+        assert_eq!(levels, [Quality::Fast, Quality::Exact]);
         for run in &runs {
             assert_eq!(run.time_limit, settings.time_limit);
             assert_eq!(run.max_frames, 1234);
