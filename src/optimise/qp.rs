@@ -1158,6 +1158,41 @@ mod tests {
     }
 
     #[test]
+    fn a_warm_start_that_fails_is_solved_again_from_cold_before_clarabel() {
+        // Infinite duals weigh every row infinitely: the warm solve fails for its numerics (duals of
+        // 1e300 do not: the solver works back from them). The same sub-problem is then solved again
+        // frame by frame from cold, which gives the cold solve's step to the last digit in as many
+        // iterations. Handed to Clarabel instead (checked), the iterations are Clarabel's and the
+        // assertion on them fails.
+        let mut s = Stream(20261130);
+        for case in 0..10 {
+            let c = random_chain(&mut s);
+            let sp = c.sub_problem();
+            let poisoned = solved_frame_by_frame(&sp, None)
+                .warm_start
+                .with_duals(f64::INFINITY);
+            let layout = Layout::of(&sp);
+            let rhs = wall_rhs(&sp);
+            let problem = stagewise::StagedProblem::new(&sp, &layout, &rhs);
+            let attempt =
+                stagewise::solve(&problem, MAX_SUBPROBLEM_ITERATIONS, 10.0, Some(&poisoned));
+            assert!(
+                attempt.is_err(),
+                "case {case}: the poisoned warm start solved"
+            );
+            let cold = solve_warm(&sp, 10.0, None);
+            let retried = solve_warm(&sp, 10.0, Some(&poisoned));
+            assert_eq!(retried.status, cold.status, "case {case}");
+            assert!(
+                matches!(cold.status, SubStepStatus::Solved { .. }),
+                "case {case}"
+            );
+            assert_eq!(retried.iterations, cold.iterations, "case {case}");
+            assert_eq!(retried.du, cold.du, "case {case}");
+        }
+    }
+
+    #[test]
     fn both_solvers_find_the_same_step_on_random_chains_of_frames() {
         // The same convex QP: the optimum's value is unique, and with strictly convex curvature so are
         // its steps and duals. Either solver wrong (a row mis-signed, a frame's dynamics or curvature

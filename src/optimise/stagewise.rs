@@ -71,6 +71,16 @@ pub struct WarmStart {
 const WARM_START_FLOOR: f64 = 0.1;
 
 impl WarmStart {
+    /// This warm start with every dual set to `lambda` (an infinite one is a start the solver cannot
+    /// work from), for tests of what a failed warm solve leads to.
+    #[cfg(test)]
+    pub(super) fn with_duals(&self, lambda: f64) -> WarmStart {
+        WarmStart {
+            lambda: vec![lambda; self.lambda.len()],
+            ..self.clone()
+        }
+    }
+
     /// Whether it holds the slacks and duals of every frame of `frames` (each with as many rows).
     fn covers(&self, frames: &[Frame]) -> bool {
         self.rows_per_frame.len() == frames.len()
