@@ -10,6 +10,8 @@
 //! 4. Quantise and verify ([`super::verify`]): yaws on anglemod steps, the plan re-simulated in f64 and in
 //!    the engine-exact mode; the fastest valid plan is kept, polished on while it gets faster (airborne
 //!    scenes), and greedy stays the answer when it is faster.
+//! 5. At `exact` ([`FinePolish`]), the faster of that plan and the cheaper level's polished on again at
+//!    half the wall margin with tight tolerances ([`super::airborne::plan_polished_finely`]).
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
@@ -525,10 +527,10 @@ fn solve_once(
     };
     // No plan crosses before the bound's frame.
     let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
-    // Stages 2 to 4.
+    // Stages 2 to 4, then 5 where the settings ask for it.
     let greedy_s = time_of(greedy);
     let mut found = plan_airborne(&mut planner, &base, warm, n, lo, greedy_s, progress);
-    if let Some(fine) = settings.fine_polish {
+    if let Some(fine) = settings.fine_polish.filter(|_| !planner.timed_out) {
         plan_polished_finely(
             &mut planner,
             &mut found,
