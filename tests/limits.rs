@@ -220,21 +220,21 @@ fn a_set_cancel_flag_returns_the_best_valid_plan_and_names_the_stage() {
 fn a_higher_level_cut_after_the_cheaper_one_keeps_the_cheaper_plan() {
     let scene = Scene::from_toml_str(&shipped("hl-bend90-100fps"), "bend")
         .unwrap_or_else(|e| panic!("{e}"));
-    let fast = solve_cancellable(
+    let balanced = solve_cancellable(
         &scene,
-        &SearchSettings::for_quality(Quality::Fast),
+        &SearchSettings::for_quality(Quality::Balanced),
         &mut |_| {},
         &AtomicBool::new(false),
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(fast.source, "optimised");
-    // `balanced` runs `fast` first: cancelled as the second level's baseline is ready, it keeps fast's
-    // plan (which `balanced` itself would beat) and says it was cut.
+    assert_eq!(balanced.source, "optimised");
+    // `exact` runs `balanced` first: cancelled as the second level's baseline is ready, it keeps
+    // balanced's plan and says it was cut.
     let cancel = AtomicBool::new(false);
     let mut baselines = 0;
     let o = solve_cancellable(
         &scene,
-        &SearchSettings::for_quality(Quality::Balanced),
+        &SearchSettings::for_quality(Quality::Exact),
         &mut |p| {
             if matches!(p, Progress::Baseline { .. }) {
                 baselines += 1;
@@ -248,8 +248,8 @@ fn a_higher_level_cut_after_the_cheaper_one_keeps_the_cheaper_plan() {
     .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(baselines, 2);
     assert_eq!(o.source, "optimised");
-    assert_eq!(o.trace.crossing, fast.trace.crossing, "fast's plan");
-    assert_eq!(o.relaxed, fast.relaxed, "fast's certificate");
+    assert_eq!(o.trace.crossing, balanced.trace.crossing, "balanced's plan");
+    assert_eq!(o.relaxed, balanced.relaxed, "balanced's certificate");
     assert_eq!(
         o.status,
         SearchStatus::Cancelled {

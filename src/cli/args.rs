@@ -88,18 +88,18 @@ pub struct ArtifactFlags {
 
 /// Accuracy levels of `solve`, cheapest first. At every level the plan is checked in f64 and in the
 /// engine-exact mode; on airborne scenes every level solves the relaxed problem, rounds it to the game's
-/// sides and polishes the plan, and the levels differ in iterations, tolerances and certificate starts,
-/// `exact` also in a last polish at half the wall margin (`SearchSettings::for_quality`); on scenes with
-/// jumps, in the grids searched.
+/// sides and polishes the plan; `balanced` and `exact` polish it on at half the wall margin, and `exact`
+/// also runs a search with more iterations, tolerances and certificate starts
+/// (`SearchSettings::for_quality`); on scenes with jumps, the levels differ in the grids searched.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum QualityArg {
     /// The fewest iterations and a coarse tolerance.
     Fast,
-    /// The default: more iterations and certificate starts, a fine tolerance; on airborne scenes runs
-    /// `fast` first and keeps the faster plan.
+    /// The default: `fast`, then its plan polished on at half the wall margin (0.01 units) with a finer
+    /// tolerance and more iterations.
     Balanced,
-    /// Balanced, then its plan (or `fast`'s, where faster) polished on at half the wall margin (0.01
-    /// units) with tight tolerances and more iterations; on airborne scenes runs `fast` first.
+    /// `balanced`, then on airborne scenes a search with more iterations, a fine tolerance and more
+    /// certificate starts, polished on as `balanced`'s; the faster plan is kept.
     Exact,
 }
 

@@ -9,8 +9,8 @@
 //! 4. each line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
 //!    fastest valid exact plan is kept;
 //! 5. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]);
-//! 6. where the settings ask for it (`exact`), polished on again at a finer wall margin and tolerance
-//!    ([`plan_polished_finely`], run by [`super::search`] after the rest).
+//! 6. where the settings ask for it (`balanced` and `exact`), polished on again at a finer wall margin
+//!    and tolerance ([`plan_polished_finely`], run by [`super::search`] after the rest).
 //!
 //! Where the relaxed stage finds no line from the seed, the certificate's greedy starts' lines are the
 //! ones rounded.
@@ -24,7 +24,7 @@ use super::relaxed::{
 };
 use super::scp::StageKind;
 use super::search::{FinePolish, Progress, SearchSettings};
-use super::verify::{quantised_and_verified, time_of};
+use super::verify::quantised_and_verified;
 use crate::sim::Trace;
 
 /// Least gain of a round of the final polish, in frames, for another round to follow
@@ -546,25 +546,18 @@ fn best_plan_polished_on(planner: &mut Planner, greedy_s: f64, best: &mut BestPl
     improved
 }
 
-/// Stage 6 (`exact`'s, [`FinePolish`]): the fastest valid plan, this run's or `below` (the plan of the
-/// levels run before it) where that one is faster, polished on again at `fine`'s wall margin, iterations
-/// and tolerance in rounds as [`best_plan_polished_on`]: each plan quantised and verified, and kept only
-/// if faster than `found`'s. Where one is, it is a start of the certificate too, as after stage 5; no plan
-/// crosses before frame `lo`, and none is kept that is not faster than `greedy_s`.
+/// Stage 6 ([`FinePolish`], where the settings ask for it): the fastest valid plan polished on again at
+/// `fine`'s wall margin, iterations and tolerance, in rounds as [`best_plan_polished_on`]: each plan
+/// quantised and verified, and kept only if faster. Where one is, it is a start of the certificate too,
+/// as after stage 5 (no plan crosses before frame `lo`); none is kept that is not faster than `greedy_s`.
 pub(super) fn plan_polished_finely(
     planner: &mut Planner,
     found: &mut AirbornePlan,
     fine: FinePolish,
-    below: Option<&Trace>,
     greedy_s: f64,
     lo: usize,
     progress: &mut dyn FnMut(Progress),
 ) {
-    let own_s = found.best.as_ref().map_or(greedy_s, |b| b.0);
-    let mut start = match below.map(|trace| (time_of(trace), trace)) {
-        Some((t, trace)) if t < own_s => Some((t, trace.clone())),
-        _ => found.best.clone(),
-    };
     let settings = SearchSettings {
         margin_units: fine.margin_units,
         polish_iters: fine.polish_iters,
@@ -572,10 +565,9 @@ pub(super) fn plan_polished_finely(
         ..*planner.settings
     };
     let mut finer = planner.fork_with(&settings);
-    let faster = best_plan_polished_on(&mut finer, greedy_s, &mut start);
+    let faster = best_plan_polished_on(&mut finer, greedy_s, &mut found.best);
     planner.join(&finer);
-    if faster && start.as_ref().is_some_and(|(t, _)| *t < own_s) {
-        found.best = start;
+    if faster {
         plan_as_certificate_start(planner, &mut found.certifier, &found.best, lo, progress);
     }
 }

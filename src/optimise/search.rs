@@ -10,8 +10,8 @@
 //! 4. Quantise and verify ([`super::verify`]): yaws on anglemod steps, the plan re-simulated in f64 and in
 //!    the engine-exact mode; the fastest valid plan is kept, polished on while it gets faster (airborne
 //!    scenes), and greedy stays the answer when it is faster.
-//! 5. At `exact` ([`FinePolish`]), the faster of that plan and the cheaper level's polished on again at
-//!    half the wall margin with tight tolerances ([`super::airborne::plan_polished_finely`]).
+//! 5. At `balanced` and `exact` ([`FinePolish`]), that plan polished on again at half the wall margin
+//!    ([`super::airborne::plan_polished_finely`]).
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
@@ -37,16 +37,17 @@ use std::time::{Duration, Instant};
 pub enum Quality {
     /// The relaxed problem with a coarse tolerance, rounded, briefly polished.
     Fast,
-    /// Relaxed, rounded, polished.
+    /// Fast, its plan then polished on at half the wall margin with a finer tolerance and more
+    /// iterations ([`FinePolish`]).
     Balanced,
-    /// Balanced, its fastest plan then polished on at half the wall margin with tight tolerances and
-    /// more iterations ([`FinePolish`]).
+    /// Balanced, then a search with more iterations, a finer tolerance and more certificate starts, its
+    /// plan polished on as balanced's; the faster plan is kept.
     Exact,
 }
 
 /// A last polish of the fastest plan, after the final polish, at a finer wall margin and tolerance than
-/// the search before it (`exact`'s): the plan is polished on from its own controls, and a plan is kept
-/// only where it is faster, so the level that has it is never slower than the same level without it.
+/// the search before it (`balanced`'s and `exact`'s): the plan is polished on from its own controls, and
+/// a plan is kept only where it is faster, so a level with it is never slower than its search without it.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct FinePolish {
     /// Wall margin of the polished plan, units.
@@ -90,14 +91,16 @@ pub struct SearchSettings {
     pub max_frames: u64,
     /// The solver each convexified sub-step is given first.
     pub sub_problem_solver: SubProblemSolver,
-    /// The last polish of the fastest airborne plan at finer settings, if any (`exact`'s).
+    /// The last polish of the fastest airborne plan at finer settings, if any (`balanced`'s and `exact`'s).
     pub fine_polish: Option<FinePolish>,
 }
 
 impl SearchSettings {
     /// The settings of a quality level.
     pub fn for_quality(quality: Quality) -> Self {
-        let base = SearchSettings {
+        // The search of `exact`: more iterations, a tighter tolerance and more certificate starts than
+        // `fast`'s.
+        let searching = SearchSettings {
             quality,
             margin_units: 0.02,
             relaxed_iters: 120,
@@ -113,22 +116,27 @@ impl SearchSettings {
             sub_problem_solver: SubProblemSolver::default(),
             fine_polish: None,
         };
+        let fast = SearchSettings {
+            relaxed_iters: 25,
+            polish_iters: 10,
+            certificate_starts: 2,
+            tol_progress_units: 1e-3,
+            ..searching
+        };
+        let fine_polish = Some(FinePolish {
+            margin_units: 0.01,
+            polish_iters: 40,
+            tol_progress_units: 1e-6,
+        });
         match quality {
-            Quality::Fast => SearchSettings {
-                relaxed_iters: 25,
-                polish_iters: 10,
-                certificate_starts: 2,
-                tol_progress_units: 1e-3,
-                ..base
+            Quality::Fast => fast,
+            Quality::Balanced => SearchSettings {
+                fine_polish,
+                ..fast
             },
-            Quality::Balanced => base,
             Quality::Exact => SearchSettings {
-                fine_polish: Some(FinePolish {
-                    margin_units: 0.01,
-                    polish_iters: 120,
-                    tol_progress_units: 1e-9,
-                }),
-                ..base
+                fine_polish,
+                ..searching
             },
         }
     }
@@ -310,12 +318,12 @@ pub fn solve(scene: &Scene, settings: &SearchSettings) -> Result<Outcome> {
 
 /// [`solve`], reporting what it does to `progress`.
 ///
-/// On airborne scenes `balanced` and `exact` first run `fast`, then themselves in the time left, and keep
-/// the fastest valid plan, so a higher level is never worse than `fast`, and a time limit that cuts it
-/// leaves `fast`'s plan rather than the greedy run. `exact` is `balanced`'s search with its fastest plan
-/// polished on at half the wall margin ([`FinePolish`]), which keeps a plan only where it is faster: it is
-/// never slower than `balanced`. The two searches differ in iterations and tolerances and so can end in
-/// different local optima.
+/// `balanced` is `fast`'s search with its plan polished on at half the wall margin ([`FinePolish`]), which
+/// keeps a plan only where it is faster: it is never slower than `fast`. On airborne scenes `exact` first
+/// runs `balanced`, then a search of its own in the time left (more iterations, a finer tolerance, more
+/// certificate starts, and the same last polish), and keeps the faster valid plan: it is never slower
+/// than `balanced`, and a time limit that cuts it leaves `balanced`'s plan rather than the greedy run. The
+/// two searches can end in different local optima.
 pub fn solve_with_progress(
     scene: &Scene,
     settings: &SearchSettings,
@@ -356,12 +364,12 @@ fn solve_within(
 ) -> Result<Outcome> {
     let started = Instant::now();
     if !scene.effects.is_air_only() {
-        return solve_once(scene, settings, budget, progress, None);
+        return solve_once(scene, settings, budget, progress);
     }
     let mut runs = level_runs(settings);
     // Never empty: it ends with the requested level.
     let first = runs.remove(0);
-    let mut best = solve_once(scene, &first, budget, progress, None)?;
+    let mut best = solve_once(scene, &first, budget, progress)?;
     let mut stats = best.stats;
     for level in runs {
         if budget.expired() {
@@ -371,8 +379,7 @@ fn solve_within(
             }
             break;
         }
-        let below = (best.source == "optimised").then_some(&best.trace);
-        let other = match solve_once(scene, &level, budget, progress, below) {
+        let other = match solve_once(scene, &level, budget, progress) {
             // A level cut before it had anything valid leaves the plan already found.
             Err(Error::Stopped { stage, .. }) => {
                 if best.status.stopped_in().is_none() {
@@ -419,7 +426,8 @@ fn level_runs(settings: &SearchSettings) -> Vec<SearchSettings> {
 fn levels_below(quality: Quality) -> &'static [Quality] {
     match quality {
         Quality::Fast => &[],
-        Quality::Balanced | Quality::Exact => &[Quality::Fast],
+        Quality::Balanced => &[],
+        Quality::Exact => &[Quality::Balanced],
     }
 }
 
@@ -476,14 +484,12 @@ impl Finisher<'_> {
 }
 
 /// One run of the search at `settings` within `budget` (see [`solve_with_progress`]): the stages of the
-/// module documentation in order. `below` is the fastest plan of the levels run before this one, which
-/// the fine polish ([`FinePolish`]) starts from where it is faster than this run's own.
+/// module documentation in order.
 fn solve_once(
     scene: &Scene,
     settings: &SearchSettings,
     budget: Budget,
     progress: &mut dyn FnMut(Progress),
-    below: Option<&Trace>,
 ) -> Result<Outcome> {
     let started = Instant::now();
     let bound = lower_bound_within(scene, &scene.corridor()?, &budget)?;
@@ -531,15 +537,7 @@ fn solve_once(
     let greedy_s = time_of(greedy);
     let mut found = plan_airborne(&mut planner, &base, warm, n, lo, greedy_s, progress);
     if let Some(fine) = settings.fine_polish.filter(|_| !planner.timed_out) {
-        plan_polished_finely(
-            &mut planner,
-            &mut found,
-            fine,
-            below,
-            greedy_s,
-            lo,
-            progress,
-        );
+        plan_polished_finely(&mut planner, &mut found, fine, greedy_s, lo, progress);
     }
     let stats = planner.stats;
     let stopped = planner
@@ -640,17 +638,18 @@ mod tests {
         };
         let runs = level_runs(&settings);
         let levels: Vec<Quality> = runs.iter().map(|r| r.quality).collect();
-        assert_eq!(levels, [Quality::Fast, Quality::Exact]);
+        assert_eq!(levels, [Quality::Balanced, Quality::Exact]);
         for run in &runs {
             assert_eq!(run.time_limit, settings.time_limit);
             assert_eq!(run.max_frames, 1234);
             assert_eq!(run.sub_problem_solver, SubProblemSolver::Clarabel);
         }
-        // The cheaper levels keep their own iterations.
+        // The cheaper level keeps its own iterations.
         assert_eq!(
             runs[0].relaxed_iters,
-            SearchSettings::for_quality(Quality::Fast).relaxed_iters
+            SearchSettings::for_quality(Quality::Balanced).relaxed_iters
         );
+        assert_ne!(runs[0].relaxed_iters, runs[1].relaxed_iters);
     }
 
     #[test]
