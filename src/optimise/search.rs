@@ -45,9 +45,10 @@ pub enum Quality {
     Exact,
 }
 
-/// A last polish of the fastest plan, after the final polish, at a finer wall margin and tolerance than
-/// the search before it (`balanced`'s and `exact`'s): the plan is polished on from its own controls, and
-/// a plan is kept only where it is faster, so a level with it is never slower than its search without it.
+/// A last polish of the fastest plan, after the final polish, at a smaller wall margin than the search
+/// before it (`balanced`'s and `exact`'s; after `fast`'s search also with a finer tolerance and more
+/// iterations): the plan is polished on from its own controls, and a plan is kept only where it is faster,
+/// so a level with it is never slower than its search without it.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct FinePolish {
     /// Wall margin of the polished plan, units.
