@@ -223,10 +223,9 @@ fn solve_limited(
     };
     if let Some(s) = staged {
         let status = SubStepStatus::Solved { almost: s.almost };
-        let step = sub_step_of(sp, &layout, status, s.x, s.dynamics_duals);
+        let step = sub_step_of(sp, &layout, status, s.x, s.dynamics_duals, s.iterations);
         return SubStep {
             warm_start: Some(s.warm_start),
-            iterations: s.iterations,
             ..step
         };
     }
@@ -238,11 +237,14 @@ fn solve_limited(
             let duals = (0..layout.n_frames)
                 .map(|k| std::array::from_fn(|i| z.get(4 * k + i).copied().unwrap_or(0.0)))
                 .collect();
-            let step = sub_step_of(sp, &layout, solution.status, solution.x, duals);
-            SubStep {
-                iterations: solution.iterations,
-                ..step
-            }
+            sub_step_of(
+                sp,
+                &layout,
+                solution.status,
+                solution.x,
+                duals,
+                solution.iterations,
+            )
         }
         Ok(_) => SubStep::failed(SubStepStatus::Failed("solution of the wrong size".into())),
         Err(no) => SubStep::failed(SubStepStatus::Failed(no.to_string())),
@@ -500,14 +502,16 @@ fn clarabel_objective(sp: &SubProblem, layout: &Layout) -> (CscMatrix<f64>, Vec<
     (p, q)
 }
 
-/// The sub-step of a solution `x` (laid out by `layout`) with the duals of its dynamics rows: its
-/// control changes, the state changes they give, and what the model predicts the step gains.
+/// The sub-step of a solution `x` (laid out by `layout`) with the duals of its dynamics rows, reached
+/// after `iterations` of its solver: its control changes, the state changes they give, and what the
+/// model predicts the step gains.
 fn sub_step_of(
     sp: &SubProblem,
     layout: &Layout,
     status: SubStepStatus,
     x: Vec<f64>,
     dynamics_duals: Vec<[f64; 4]>,
+    iterations: u32,
 ) -> SubStep {
     let n = layout.n_frames;
     // The step is judged on what its control changes do: a solver meets the dynamics rows only to its
@@ -530,7 +534,7 @@ fn sub_step_of(
         predicted,
         dynamics_duals,
         warm_start: None,
-        iterations: 0,
+        iterations,
     }
 }
 
@@ -1112,15 +1116,22 @@ mod tests {
     }
 
     /// `sp` laid out and solved frame by frame, from `warm` if given.
+    fn frame_by_frame(
+        sp: &SubProblem,
+        warm: Option<&WarmStart>,
+    ) -> Result<stagewise::StagedSolution, stagewise::NotStaged> {
+        let layout = Layout::of(sp);
+        let rhs = wall_rhs(sp);
+        let problem = stagewise::StagedProblem::new(sp, &layout, &rhs);
+        stagewise::solve(&problem, MAX_SUBPROBLEM_ITERATIONS, 10.0, warm)
+    }
+
+    /// [`frame_by_frame`], which must give a solution.
     fn solved_frame_by_frame(
         sp: &SubProblem,
         warm: Option<&WarmStart>,
     ) -> stagewise::StagedSolution {
-        let layout = Layout::of(sp);
-        let rhs = wall_rhs(sp);
-        let problem = stagewise::StagedProblem::new(sp, &layout, &rhs);
-        let solved = stagewise::solve(&problem, MAX_SUBPROBLEM_ITERATIONS, 10.0, warm);
-        solved.unwrap_or_else(|e| panic!("{e:?}"))
+        frame_by_frame(sp, warm).unwrap_or_else(|e| panic!("{e:?}"))
     }
 
     #[test]
@@ -1171,13 +1182,8 @@ mod tests {
             let poisoned = solved_frame_by_frame(&sp, None)
                 .warm_start
                 .with_duals(f64::INFINITY);
-            let layout = Layout::of(&sp);
-            let rhs = wall_rhs(&sp);
-            let problem = stagewise::StagedProblem::new(&sp, &layout, &rhs);
-            let attempt =
-                stagewise::solve(&problem, MAX_SUBPROBLEM_ITERATIONS, 10.0, Some(&poisoned));
             assert!(
-                attempt.is_err(),
+                frame_by_frame(&sp, Some(&poisoned)).is_err(),
                 "case {case}: the poisoned warm start solved"
             );
             let cold = solve_warm(&sp, 10.0, None);

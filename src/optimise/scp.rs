@@ -491,20 +491,17 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
             Ok(qp::solve_warm(
                 &pr.sub_problem(&lz, None),
                 seconds_left,
-                self.warm_start.as_ref().filter(|_| pr.warm_started()),
+                self.warm_start_for(pr),
             ))
         })?;
-        self.keep_warm_start(&mut step);
         self.stats.iterations += 1;
-        self.stats.subproblems += 1;
-        self.stats.interior_point_iterations += u64::from(step.iterations);
+        self.sub_problem_solved(&mut step);
         let du = match step.status {
             SubStepStatus::Solved { .. } => {
                 self.duals = Some(step.dynamics_duals);
                 step.du
             }
             SubStepStatus::Failed(_) => {
-                self.stats.subproblem_failures += 1;
                 self.trust *= 0.25;
                 return Ok((state, None));
             }
@@ -584,10 +581,22 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
 }
 
 impl ScpSolver<'_> {
-    /// Where `step`'s solver ended, if it says, as the start of the next sub-problem.
-    fn keep_warm_start(&mut self, step: &mut qp::SubStep) {
+    /// The warm start of `pr`'s next sub-problem: where the last one's solver ended, in the stages that
+    /// take one ([`ScpProblem::warm_started`]).
+    fn warm_start_for(&self, pr: &ScpProblem<'_>) -> Option<&qp::WarmStart> {
+        self.warm_start.as_ref().filter(|_| pr.warm_started())
+    }
+
+    /// A sub-problem solved (or failed): its work counted, and where its solver ended, if it says, kept
+    /// as the start of the next one.
+    fn sub_problem_solved(&mut self, step: &mut qp::SubStep) {
         if let Some(warm) = step.warm_start.take() {
             self.warm_start = Some(warm);
+        }
+        self.stats.subproblems += 1;
+        self.stats.interior_point_iterations += u64::from(step.iterations);
+        if !matches!(step.status, SubStepStatus::Solved { .. }) {
+            self.stats.subproblem_failures += 1;
         }
     }
 
@@ -623,17 +632,14 @@ impl ScpSolver<'_> {
             Ok(Some(qp::solve_warm(
                 &pr.sub_problem(lz, Some(&left_out)),
                 seconds_left,
-                self.warm_start.as_ref().filter(|_| pr.warm_started()),
+                self.warm_start_for(pr),
             )))
         })?;
         let Some(mut corrected) = corrected else {
             return Ok(None);
         };
-        self.keep_warm_start(&mut corrected);
-        self.stats.subproblems += 1;
-        self.stats.interior_point_iterations += u64::from(corrected.iterations);
+        self.sub_problem_solved(&mut corrected);
         if !matches!(corrected.status, SubStepStatus::Solved { .. }) {
-            self.stats.subproblem_failures += 1;
             return Ok(None);
         }
         let corrected = stepped(controls, &corrected.du);

@@ -426,8 +426,7 @@ fn level_runs(settings: &SearchSettings) -> Vec<SearchSettings> {
 /// of a cheaper one rather than the greedy run.
 fn levels_below(quality: Quality) -> &'static [Quality] {
     match quality {
-        Quality::Fast => &[],
-        Quality::Balanced => &[],
+        Quality::Fast | Quality::Balanced => &[],
         Quality::Exact => &[Quality::Balanced],
     }
 }

@@ -401,23 +401,31 @@ pub(super) fn solve(
     }
     let tolerances = Tolerances::of(p, &frames);
     let mut almost = false;
-    let solved_after = |iterations: u32, it: Iterate, almost: bool| StagedSolution {
-        iterations,
-        ..solution(p, &frames, &wall_rows, &offsets, it, almost)
-    };
     for iteration in 0..max_iterations {
         if clock.elapsed().as_secs_f64() > time_limit_s {
             return Err(NotStaged::TimeLimit);
         }
         match tolerances.met(p, &frames, &offsets, &it) {
-            Met::Solved => return Ok(solved_after(iteration, it, false)),
+            Met::Solved => {
+                return Ok(solution(
+                    p, &frames, &wall_rows, &offsets, it, false, iteration,
+                ))
+            }
             Met::Almost => almost = true,
             Met::Not => almost = false,
         }
         mehrotra_step(p, &frames, &offsets, &mut it)?;
     }
     if almost {
-        return Ok(solved_after(max_iterations, it, true));
+        return Ok(solution(
+            p,
+            &frames,
+            &wall_rows,
+            &offsets,
+            it,
+            true,
+            max_iterations,
+        ));
     }
     Err(NotStaged::MaxIterations)
 }
@@ -846,8 +854,8 @@ fn cholesky_solve(
 /// The iterate in Clarabel's layout, with the duals of the dynamics rows: `z_k = -a_k`, `a_k` the
 /// gradient of the Lagrangian in the state change after frame `k` through all later frames (its
 /// direct terms: the next frame's curvature, the last frame's progress and the wall rows of frame `k`'s
-/// end, which the frames hold through their dynamics and so are added back here). Its iteration count
-/// is the caller's to fill in.
+/// end, which the frames hold through their dynamics and so are added back here), reached after
+/// `iterations`.
 fn solution(
     p: &StagedProblem,
     frames: &[Frame],
@@ -855,6 +863,7 @@ fn solution(
     offsets: &[usize],
     it: Iterate,
     almost: bool,
+    iterations: u32,
 ) -> StagedSolution {
     let n = frames.len();
     let layout = p.layout;
@@ -911,7 +920,7 @@ fn solution(
             t: it.t,
             lambda: it.lambda,
         },
-        iterations: 0,
+        iterations,
     }
 }
 
