@@ -9,8 +9,8 @@
 //! 4. each line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
 //!    fastest valid exact plan is kept;
 //! 5. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]);
-//! 6. where the settings ask for it (`balanced` and `exact`), polished on again at a finer wall margin
-//!    and tolerance ([`plan_polished_finely`], run by [`super::search`] after the rest).
+//! 6. where the settings ask for it (`balanced` and `exact`), polished on again at a smaller wall margin
+//!    ([`plan_polished_finely`], run by [`super::search`] after the rest).
 //!
 //! Where the relaxed stage finds no line from the seed, the certificate's greedy starts' lines are the
 //! ones rounded.
