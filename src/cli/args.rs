@@ -89,8 +89,8 @@ pub struct ArtifactFlags {
 /// Accuracy levels of `solve`, cheapest first. At every level the plan is checked in f64 and in the
 /// engine-exact mode; on airborne scenes every level solves the relaxed problem, rounds it to the game's
 /// sides and polishes the plan; `balanced` and `exact` polish it on at half the wall margin, and `exact`
-/// also runs a search with more iterations, tolerances and certificate starts
-/// (`SearchSettings::for_quality`); on scenes with jumps, the levels differ in the grids searched.
+/// on again at the certificate's margin (`SearchSettings::for_quality`); on scenes with jumps, the levels
+/// differ in the grids searched.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum QualityArg {
     /// The fewest iterations and a coarse tolerance.
@@ -98,8 +98,8 @@ pub enum QualityArg {
     /// The default: `fast`, then its plan polished on at half the wall margin (0.01 units) with a finer
     /// tolerance and more iterations.
     Balanced,
-    /// `balanced`, then on airborne scenes a search with more iterations, a fine tolerance and more
-    /// certificate starts, polished on as `balanced`'s; the faster plan is kept.
+    /// `balanced`, then on airborne scenes its plan polished on again at the certificate's wall margin
+    /// (0.002 units), the smallest the search holds; a plan is kept only where it is faster.
     Exact,
 }
 

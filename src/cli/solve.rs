@@ -56,6 +56,12 @@ pub fn run(args: &SolveArgs) -> Result<String> {
             bar.set_prefix(Stage::Rounding.name());
             bar.set_message("rounding sides, polishing, checking in engine-exact mode");
         }
+        search::Progress::Polishing { margin_units } => {
+            bar.set_prefix(Stage::Rounding.name());
+            bar.set_message(format!(
+                "polishing the plan on at a wall margin of {margin_units} units"
+            ));
+        }
     });
     bar.finish_and_clear();
     let mut outcome = outcome?;

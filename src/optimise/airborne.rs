@@ -9,7 +9,7 @@
 //! 4. each line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
 //!    fastest valid exact plan is kept;
 //! 5. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]);
-//! 6. where the settings ask for it (`balanced` and `exact`), polished on again at a smaller wall margin
+//! 6. where the settings ask for it (`balanced` and `exact`), polished on again at smaller wall margins
 //!    ([`plan_polished_finely`], run by [`super::search`] after the rest).
 //!
 //! Where the relaxed stage finds no line from the seed, the certificate's greedy starts' lines are the
@@ -547,9 +547,10 @@ fn best_plan_polished_on(planner: &mut Planner, greedy_s: f64, best: &mut BestPl
 }
 
 /// Stage 6 ([`FinePolish`], where the settings ask for it): the fastest valid plan polished on again at
-/// `fine`'s wall margin, iterations and tolerance, in rounds as [`best_plan_polished_on`]: each plan
-/// quantised and verified, and kept only if faster. Where one is, it is a start of the certificate too,
-/// as after stage 5 (no plan crosses before frame `lo`); none is kept that is not faster than `greedy_s`.
+/// each of `fine`'s wall margins in turn, with its iterations and tolerance, in rounds as
+/// [`best_plan_polished_on`]: each plan quantised and verified, and kept only if faster. Where one is,
+/// the plan is a start of the certificate too once the last margin is done, as after stage 5 (no plan
+/// crosses before frame `lo`); none is kept that is not faster than `greedy_s`.
 pub(super) fn plan_polished_finely(
     planner: &mut Planner,
     found: &mut AirbornePlan,
@@ -558,15 +559,22 @@ pub(super) fn plan_polished_finely(
     lo: usize,
     progress: &mut dyn FnMut(Progress),
 ) {
-    let settings = SearchSettings {
-        margin_units: fine.margin_units,
-        polish_iters: fine.polish_iters,
-        tol_progress_units: fine.tol_progress_units,
-        ..*planner.settings
-    };
-    let mut finer = planner.fork_with(&settings);
-    let faster = best_plan_polished_on(&mut finer, greedy_s, &mut found.best);
-    planner.join(&finer);
+    let mut faster = false;
+    for &margin_units in fine.margins_units {
+        if planner.timed_out {
+            break;
+        }
+        progress(Progress::Polishing { margin_units });
+        let settings = SearchSettings {
+            margin_units,
+            polish_iters: fine.polish_iters,
+            tol_progress_units: fine.tol_progress_units,
+            ..*planner.settings
+        };
+        let mut finer = planner.fork_with(&settings);
+        faster |= best_plan_polished_on(&mut finer, greedy_s, &mut found.best);
+        planner.join(&finer);
+    }
     if faster {
         plan_as_certificate_start(planner, &mut found.certifier, &found.best, lo, progress);
     }

@@ -145,7 +145,7 @@ impl Relaxation {
 /// [`super::scp::ScpProblem::violation`]), so the certificate holds every plan at least 0.001 units off the
 /// walls (a ten-thousandth of a frame at 700 ups and 100 fps). At a margin of zero, the second-order
 /// error of each step along a wall lands a hair inside it and the stage never counts a plan as clear.
-const CERTIFICATE_MARGIN_UNITS: f64 = 0.002;
+pub(super) const CERTIFICATE_MARGIN_UNITS: f64 = 0.002;
 
 /// The least clearance of the runs the certificate holds, units: half its margin
 /// ([`CERTIFICATE_MARGIN_UNITS`]). A run closer to a wall (one that touches or slides along it) is not a

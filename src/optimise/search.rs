@@ -10,8 +10,9 @@
 //! 4. Quantise and verify ([`super::verify`]): yaws on anglemod steps, the plan re-simulated in f64 and in
 //!    the engine-exact mode; the fastest valid plan is kept, polished on while it gets faster (airborne
 //!    scenes), and greedy stays the answer when it is faster.
-//! 5. At `balanced` and `exact` ([`FinePolish`]), that plan polished on again at half the wall margin
-//!    ([`super::airborne::plan_polished_finely`]).
+//! 5. At `balanced` and `exact` ([`FinePolish`]), that plan polished on again at smaller wall margins
+//!    ([`super::airborne::plan_polished_finely`]): half the final margin, and at `exact` then the
+//!    certificate's.
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
@@ -20,7 +21,7 @@ use super::baseline::{baseline, corner_caps, given_up_frame, GreedyGuide, GuideR
 use super::bound::{frame_limited_scene, lower_bound_within};
 use super::planner::Planner;
 use super::qp::SubProblemSolver;
-use super::relaxed::RelaxedCertificate;
+use super::relaxed::{RelaxedCertificate, CERTIFICATE_MARGIN_UNITS};
 use super::verify::time_of;
 use super::LowerBound;
 use crate::budget::{Budget, Stage, Stop};
@@ -40,24 +41,35 @@ pub enum Quality {
     /// Fast, its plan then polished on at half the wall margin with a finer tolerance and more
     /// iterations ([`FinePolish`]).
     Balanced,
-    /// Balanced, then a search with more iterations, a finer tolerance and more certificate starts, its
-    /// plan polished on as balanced's; the faster plan is kept.
+    /// Balanced, its plan then polished on again at the certificate's wall margin, the smallest the
+    /// search holds ([`FinePolish`]).
     Exact,
 }
 
-/// A last polish of the fastest plan, after the final polish, at a smaller wall margin than the search
-/// before it (`balanced`'s and `exact`'s; after `fast`'s search also with a finer tolerance and more
-/// iterations): the plan is polished on from its own controls, and a plan is kept only where it is faster,
-/// so a level with it is never slower than its search without it.
+/// The last polishes of the fastest plan, after the final polish, at smaller wall margins than the search
+/// before them, one after another, with a finer tolerance and more iterations than `fast`'s (`balanced`'s
+/// and `exact`'s): the plan is polished on from its own controls, and a plan is kept only where it is
+/// faster, so a level with them is never slower than its search without them.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct FinePolish {
-    /// Wall margin of the polished plan, units.
-    pub margin_units: f64,
+    /// Wall margins of the polished plans, in the order polished, units.
+    pub margins_units: &'static [f64],
     /// SCP iterations of each of its stages.
     pub polish_iters: u64,
     /// Stop when the predicted improvement is below this, units of progress.
     pub tol_progress_units: f64,
 }
+
+/// The wall margin of `fast`'s plans, units: room for the engine's f32 arithmetic and anglemod (a plan
+/// is kept only if its engine-exact replay is valid too, so the finer polishes may go closer).
+const FINAL_MARGIN_UNITS: f64 = 0.02;
+
+/// `balanced`'s last polish: at half the final margin.
+const BALANCED_MARGINS_UNITS: &[f64] = &[0.5 * FINAL_MARGIN_UNITS];
+
+/// `exact`'s last polishes: `balanced`'s, then at the certificate's margin, so that the plan and the
+/// certificate are points of one problem.
+const EXACT_MARGINS_UNITS: &[f64] = &[0.5 * FINAL_MARGIN_UNITS, CERTIFICATE_MARGIN_UNITS];
 
 /// Settings of the search, with their units. `Default` is `balanced`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -92,52 +104,47 @@ pub struct SearchSettings {
     pub max_frames: u64,
     /// The solver each convexified sub-step is given first.
     pub sub_problem_solver: SubProblemSolver,
-    /// The last polish of the fastest airborne plan at finer settings, if any (`balanced`'s and `exact`'s).
+    /// The last polishes of the fastest airborne plan at finer settings, if any (`balanced`'s and
+    /// `exact`'s).
     pub fine_polish: Option<FinePolish>,
 }
 
 impl SearchSettings {
     /// The settings of a quality level.
     pub fn for_quality(quality: Quality) -> Self {
-        // The search of `exact`: more iterations, a tighter tolerance and more certificate starts than
-        // `fast`'s.
-        let searching = SearchSettings {
+        // Every level searches as `fast` does; the dearer ones then polish its plan closer to the walls.
+        let fast = SearchSettings {
             quality,
-            margin_units: 0.02,
-            relaxed_iters: 120,
-            polish_iters: 40,
+            margin_units: FINAL_MARGIN_UNITS,
+            relaxed_iters: 25,
+            polish_iters: 10,
             capped_line_returns: 3,
             final_polish_rounds: 3,
-            tol_progress_units: 1e-6,
+            tol_progress_units: 1e-3,
             slack_weight: 100.0,
             wall_radius_units: 40.0,
-            certificate_starts: 3,
+            certificate_starts: 2,
             time_limit: None,
             max_frames: crate::budget::DEFAULT_MAX_PLANNED_FRAMES,
             sub_problem_solver: SubProblemSolver::default(),
             fine_polish: None,
         };
-        let fast = SearchSettings {
-            relaxed_iters: 25,
-            polish_iters: 10,
-            certificate_starts: 2,
-            tol_progress_units: 1e-3,
-            ..searching
+        let fine_polish = |margins_units| {
+            Some(FinePolish {
+                margins_units,
+                polish_iters: 40,
+                tol_progress_units: 1e-6,
+            })
         };
-        let fine_polish = Some(FinePolish {
-            margin_units: 0.01,
-            polish_iters: 40,
-            tol_progress_units: 1e-6,
-        });
         match quality {
             Quality::Fast => fast,
             Quality::Balanced => SearchSettings {
-                fine_polish,
+                fine_polish: fine_polish(BALANCED_MARGINS_UNITS),
                 ..fast
             },
             Quality::Exact => SearchSettings {
-                fine_polish,
-                ..searching
+                fine_polish: fine_polish(EXACT_MARGINS_UNITS),
+                ..fast
             },
         }
     }
@@ -309,6 +316,11 @@ pub enum Progress {
     },
     /// Rounding, polishing and checking the plan.
     Finishing,
+    /// Polishing the plan on at a smaller wall margin ([`FinePolish`]).
+    Polishing {
+        /// The wall margin, units.
+        margin_units: f64,
+    },
 }
 
 /// The minimal-time plan of `scene` (see the module documentation). Errors only for bad input or a scene
@@ -319,12 +331,10 @@ pub fn solve(scene: &Scene, settings: &SearchSettings) -> Result<Outcome> {
 
 /// [`solve`], reporting what it does to `progress`.
 ///
-/// `balanced` is `fast`'s search with its plan polished on at half the wall margin ([`FinePolish`]), which
-/// keeps a plan only where it is faster: it is never slower than `fast`. On airborne scenes `exact` first
-/// runs `balanced`, then a search of its own in the time left (more iterations, a finer tolerance, more
-/// certificate starts, and the same last polish), and keeps the faster valid plan: it is never slower
-/// than `balanced`, and a time limit that cuts it leaves `balanced`'s plan rather than the greedy run. The
-/// two searches can end in different local optima.
+/// `balanced` is `fast`'s search with its plan polished on at half the wall margin ([`FinePolish`]), and
+/// `exact` is `balanced` with that plan polished on again at the certificate's margin. A polish keeps a
+/// plan only where it is faster: `balanced` is never slower than `fast`, nor `exact` than `balanced`, and
+/// a time limit that cuts a polish leaves the plan before it.
 pub fn solve_with_progress(
     scene: &Scene,
     settings: &SearchSettings,
@@ -333,8 +343,8 @@ pub fn solve_with_progress(
     solve_within(
         scene,
         settings,
-        progress,
         Budget::from_limit(settings.time_limit, None),
+        progress,
     )
 }
 
@@ -351,84 +361,9 @@ pub fn solve_cancellable(
     solve_within(
         scene,
         settings,
-        progress,
         Budget::from_limit(settings.time_limit, Some(cancel)),
+        progress,
     )
-}
-
-/// The solve of every entry point, within `budget` (which covers every level run).
-fn solve_within(
-    scene: &Scene,
-    settings: &SearchSettings,
-    progress: &mut dyn FnMut(Progress),
-    budget: Budget,
-) -> Result<Outcome> {
-    let started = Instant::now();
-    if !scene.effects.is_air_only() {
-        return solve_once(scene, settings, budget, progress);
-    }
-    let mut runs = level_runs(settings);
-    // Never empty: it ends with the requested level.
-    let first = runs.remove(0);
-    let mut best = solve_once(scene, &first, budget, progress)?;
-    let mut stats = best.stats;
-    for level in runs {
-        if budget.expired() {
-            // The plan kept is a cheaper level's: the next one was cut before its first stage.
-            if best.status.stopped_in().is_none() {
-                best.status = SearchStatus::stopped(&budget, Stage::LowerBound);
-            }
-            break;
-        }
-        let other = match solve_once(scene, &level, budget, progress) {
-            // A level cut before it had anything valid leaves the plan already found.
-            Err(Error::Stopped { stage, .. }) => {
-                if best.status.stopped_in().is_none() {
-                    best.status = SearchStatus::stopped(&budget, stage);
-                }
-                break;
-            }
-            other => other?,
-        };
-        stats.add(&other.stats);
-        // Ties go to the higher level, whose certificate had more starts.
-        if other.source == "optimised" && time_of(&other.trace) <= time_of(&best.trace) {
-            best = other;
-        } else if let Some(stage) = other.status.stopped_in() {
-            // The plan kept is a cheaper level's, and the time limit (or cancel flag) cut this one.
-            best.status = SearchStatus::stopped(&budget, stage);
-        }
-    }
-    // The work of every run.
-    best.stats = stats;
-    best.solve_seconds = started.elapsed().as_secs_f64();
-    Ok(best)
-}
-
-/// The settings of each level an airborne solve at `settings` runs, cheapest first: the cheaper levels'
-/// own settings with the caller's time limit, frame limit and sub-problem solver, then `settings`.
-fn level_runs(settings: &SearchSettings) -> Vec<SearchSettings> {
-    let mut runs: Vec<SearchSettings> = levels_below(settings.quality)
-        .iter()
-        .map(|&quality| SearchSettings {
-            time_limit: settings.time_limit,
-            max_frames: settings.max_frames,
-            sub_problem_solver: settings.sub_problem_solver,
-            ..SearchSettings::for_quality(quality)
-        })
-        .collect();
-    runs.push(*settings);
-    runs
-}
-
-/// The levels an airborne solve at `quality` runs before it, cheapest first: each has a valid plan
-/// ready before the next, dearer one starts, so a time limit that cuts a higher level leaves the plan
-/// of a cheaper one rather than the greedy run.
-fn levels_below(quality: Quality) -> &'static [Quality] {
-    match quality {
-        Quality::Fast | Quality::Balanced => &[],
-        Quality::Exact => &[Quality::Balanced],
-    }
 }
 
 /// What every outcome of one solve shares: the simulation, the baseline, the bound, the start time.
@@ -483,9 +418,9 @@ impl Finisher<'_> {
     }
 }
 
-/// One run of the search at `settings` within `budget` (see [`solve_with_progress`]): the stages of the
-/// module documentation in order.
-fn solve_once(
+/// The solve of every entry point, at `settings` within `budget` (see [`solve_with_progress`]): the
+/// stages of the module documentation in order.
+fn solve_within(
     scene: &Scene,
     settings: &SearchSettings,
     budget: Budget,
@@ -629,27 +564,29 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_level_an_exact_solve_runs_keeps_the_callers_limits_and_sub_problem_solver() {
-        let settings = SearchSettings {
-            time_limit: Some(Duration::from_secs(7)),
-            max_frames: 1234,
-            sub_problem_solver: SubProblemSolver::Clarabel,
-            ..SearchSettings::for_quality(Quality::Exact)
-        };
-        let runs = level_runs(&settings);
-        let levels: Vec<Quality> = runs.iter().map(|r| r.quality).collect();
-        assert_eq!(levels, [Quality::Balanced, Quality::Exact]);
-        for run in &runs {
-            assert_eq!(run.time_limit, settings.time_limit);
-            assert_eq!(run.max_frames, 1234);
-            assert_eq!(run.sub_problem_solver, SubProblemSolver::Clarabel);
+    fn every_level_searches_as_fast_and_each_dearer_one_polishes_on_closer_to_the_walls() {
+        let [fast, balanced, exact] =
+            [Quality::Fast, Quality::Balanced, Quality::Exact].map(SearchSettings::for_quality);
+        for level in [balanced, exact] {
+            let search = SearchSettings {
+                quality: Quality::Fast,
+                fine_polish: None,
+                ..level
+            };
+            assert_eq!(search, fast, "{:?} searches as fast does", level.quality);
         }
-        // The cheaper level keeps its own iterations.
-        assert_eq!(
-            runs[0].relaxed_iters,
-            SearchSettings::for_quality(Quality::Balanced).relaxed_iters
-        );
-        assert_ne!(runs[0].relaxed_iters, runs[1].relaxed_iters);
+        assert_eq!(fast.fine_polish, None);
+        let margins = |s: SearchSettings| s.fine_polish.map_or(&[][..], |f| f.margins_units);
+        // A dearer level polishes on from where the cheaper one ends, so it is never slower.
+        assert!(margins(exact).starts_with(margins(balanced)));
+        assert!(margins(exact).len() > margins(balanced).len());
+        let mut wall_margin = fast.margin_units;
+        for &m in margins(exact) {
+            assert!(m < wall_margin, "{:?}", margins(exact));
+            wall_margin = m;
+        }
+        // The last is the certificate's, the smallest the search holds.
+        assert_eq!(margins(exact).last(), Some(&CERTIFICATE_MARGIN_UNITS));
     }
 
     #[test]

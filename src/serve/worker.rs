@@ -268,6 +268,9 @@ fn stage_text(p: &Progress) -> String {
             ))
         ),
         Progress::Finishing => "rounding sides, polishing, checking in engine-exact mode".into(),
+        Progress::Polishing { margin_units } => {
+            format!("polishing the plan on at a wall margin of {margin_units} units")
+        }
     }
 }
 
