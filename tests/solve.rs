@@ -196,7 +196,7 @@ fn the_final_polish_makes_a_plan_still_improving_faster() {
 }
 
 #[test]
-fn each_level_polishes_the_plan_below_on_closer_to_the_walls() {
+fn each_level_polishes_the_plan_below_on_to_a_sooner_crossing() {
     // Generated scene 5 of seed 12 (CI-sized family: 100 fps, 99 frames): `fast`'s plan crosses at
     // 0.9822025 s; polished on from its own controls at half the wall margin with tight tolerances, as
     // `balanced` does, 0.9821828 s; polished on again at the certificate's margin, as `exact` does,
