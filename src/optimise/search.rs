@@ -64,12 +64,15 @@ pub struct FinePolish {
 /// is kept only if its engine-exact replay is valid too, so the finer polishes may go closer).
 const FINAL_MARGIN_UNITS: f64 = 0.02;
 
+/// The margin of the first last polish, units: half the final margin.
+const HALF_FINAL_MARGIN_UNITS: f64 = 0.5 * FINAL_MARGIN_UNITS;
+
 /// `balanced`'s last polish: at half the final margin.
-const BALANCED_MARGINS_UNITS: &[f64] = &[0.5 * FINAL_MARGIN_UNITS];
+const BALANCED_MARGINS_UNITS: &[f64] = &[HALF_FINAL_MARGIN_UNITS];
 
 /// `exact`'s last polishes: `balanced`'s, then at the certificate's margin, so that the plan and the
 /// certificate are points of one problem.
-const EXACT_MARGINS_UNITS: &[f64] = &[0.5 * FINAL_MARGIN_UNITS, CERTIFICATE_MARGIN_UNITS];
+const EXACT_MARGINS_UNITS: &[f64] = &[HALF_FINAL_MARGIN_UNITS, CERTIFICATE_MARGIN_UNITS];
 
 /// Settings of the search, with their units. `Default` is `balanced`.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -471,7 +474,7 @@ fn solve_within(
     // Stages 2 to 4, then 5 where the settings ask for it.
     let greedy_s = time_of(greedy);
     let mut found = plan_airborne(&mut planner, &base, warm, n, lo, greedy_s, progress);
-    if let Some(fine) = settings.fine_polish.filter(|_| !planner.timed_out) {
+    if let Some(fine) = settings.fine_polish {
         plan_polished_finely(&mut planner, &mut found, fine, greedy_s, lo, progress);
     }
     let stats = planner.stats;
