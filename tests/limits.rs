@@ -255,11 +255,11 @@ fn exact_cut_as_its_last_polish_starts_keeps_balanceds_plan() {
     assert_eq!(polishes, 2);
     assert_eq!(o.source, "optimised");
     assert_eq!(o.controls, balanced.controls, "balanced's plan");
-    // The polish does not note its own cut: the replay of its first plan is where the cut is noticed.
+    // Cut in the polish's own stages, not in the replay of what they gave.
     assert_eq!(
         o.status,
         SearchStatus::Cancelled {
-            stopped_in: Stage::Verification
+            stopped_in: Stage::Rounding
         }
     );
     assert!(o.trace.feasible() && o.engine_exact.feasible());

@@ -246,6 +246,8 @@ pub(super) fn polished_again(
     kind: StageKind,
 ) -> Vec<Vec<FrameControl>> {
     let Polished { plans, added } = polished_if_set(planner, exact, margin, kind);
+    // A cut in these stages is the polish's, as in the rounding's own polish.
+    planner.note_cut(Stage::Rounding);
     plans.into_iter().chain(added).collect()
 }
 
