@@ -157,6 +157,10 @@ impl Row {
 
     /// `g += weight (c, d)`: the row's pull on a frame's gradient at dual `weight`.
     fn add_to(&self, g: &mut [f64; 4 + MAX_FRAME_VARS], weight: f64) {
+        if let Some(at) = self.bound {
+            g[4 + at] += self.d[at] * weight;
+            return;
+        }
         for (gi, a) in g.iter_mut().zip(self.c.iter().chain(&self.d)) {
             *gi += a * weight;
         }
@@ -191,6 +195,9 @@ impl Frame {
 
     /// `c . dx + d . v` of a row.
     fn row_value(&self, row: &Row, dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> f64 {
+        if let Some(at) = row.bound {
+            return row.d[at] * v[at];
+        }
         (0..4).map(|i| row.c[i] * dx[i]).sum::<f64>()
             + (0..self.nv()).map(|j| row.d[j] * v[j]).sum::<f64>()
     }
@@ -200,14 +207,23 @@ impl Frame {
         let z = joined(dx, v);
         let n = 4 + self.nv();
         std::array::from_fn(|i| {
-            if i < n {
-                self.gradient[i] + (0..n).map(|j| self.hessian[i][j] * z[j]).sum::<f64>()
+            if i < CURVED_FROM {
+                self.gradient[i]
+            } else if i < n {
+                self.gradient[i]
+                    + (CURVED_FROM..n)
+                        .map(|j| self.hessian[i][j] * z[j])
+                        .sum::<f64>()
             } else {
                 0.0
             }
         })
     }
 }
+
+/// The first entry of `z = (dx_{k-1}, v_k)` a frame's cost is curved in: the position `(px, py)` enters
+/// the frame linearly, so the Hessian's first two rows and columns are zero.
+const CURVED_FROM: usize = 2;
 
 fn joined(dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> [f64; 4 + MAX_FRAME_VARS] {
     std::array::from_fn(|i| if i < 4 { dx[i] } else { v[i - 4] })
@@ -314,6 +330,7 @@ fn frame_without_walls(p: &StagedProblem, k: usize, slack: Option<usize>) -> Fra
         for (i, ai) in inputs.iter().enumerate() {
             for (j, aj) in inputs.iter().enumerate() {
                 if let (Some((r, sr)), Some((c, sc))) = (ai, aj) {
+                    debug_assert!(*r >= CURVED_FROM && *c >= CURVED_FROM);
                     hessian[*r][*c] += block[i][j] * sr * sc;
                 }
             }
@@ -658,7 +675,6 @@ fn factorised(
     let mut value = [[0.0; 4]; 4];
     for (k, f) in frames.iter().enumerate().rev() {
         let nv = f.nv();
-        let n = 4 + nv;
         let mut h = f.hessian;
         for (r, row) in f.rows.iter().enumerate() {
             let w = it.lambda[offsets[k] + r] / it.t[offsets[k] + r];
@@ -666,10 +682,13 @@ fn factorised(
                 h[4 + at][4 + at] += w;
                 continue;
             }
+            // Over every entry, not the frame's `n` alone: fixed bounds let the loop unroll, and the
+            // entries past `n` (where `z` is zero) are not read.
             let z = joined(&row.c, &row.d);
-            for i in 0..n {
-                for j in 0..n {
-                    h[i][j] += w * z[i] * z[j];
+            for (hi, zi) in h.iter_mut().zip(z) {
+                let wz = w * zi;
+                for (hij, zj) in hi.iter_mut().zip(z) {
+                    *hij += wz * zj;
                 }
             }
         }
@@ -820,7 +839,11 @@ fn cholesky(
     let mut l = [[0.0; MAX_FRAME_VARS]; MAX_FRAME_VARS];
     for i in 0..n {
         for j in 0..=i {
-            let s = a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+            let mut sum = 0.0;
+            for (lik, ljk) in l[i][..j].iter().zip(&l[j][..j]) {
+                sum += lik * ljk;
+            }
+            let s = a[i][j] - sum;
             if i == j {
                 if !(s > 0.0 && s.is_finite()) {
                     return None;
@@ -840,13 +863,22 @@ fn cholesky_solve(
     n: usize,
     b: &[f64; MAX_FRAME_VARS],
 ) -> [f64; MAX_FRAME_VARS] {
+    // Plain loops: the sums' closures were not inlined here, and this runs per frame and column.
     let mut y = [0.0; MAX_FRAME_VARS];
     for i in 0..n {
-        y[i] = (b[i] - (0..i).map(|k| l[i][k] * y[k]).sum::<f64>()) / l[i][i];
+        let mut sum = 0.0;
+        for (lik, yk) in l[i][..i].iter().zip(&y[..i]) {
+            sum += lik * yk;
+        }
+        y[i] = (b[i] - sum) / l[i][i];
     }
     let mut x = [0.0; MAX_FRAME_VARS];
     for i in (0..n).rev() {
-        x[i] = (y[i] - (i + 1..n).map(|k| l[k][i] * x[k]).sum::<f64>()) / l[i][i];
+        let mut sum = 0.0;
+        for (lk, xk) in l[i + 1..n].iter().zip(&x[i + 1..n]) {
+            sum += lk[i] * xk;
+        }
+        x[i] = (y[i] - sum) / l[i][i];
     }
     x
 }
