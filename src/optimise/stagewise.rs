@@ -960,6 +960,7 @@ fn solution(
 mod tests {
     use super::*;
     use crate::geometry::HalfPlane;
+    use crate::optimise::lagrangian::CurvatureBlock;
     use crate::optimise::model::FrameJacobian;
     use crate::optimise::qp::{SubProblemSolver, WallRow, C_SCALE_UPS};
     use crate::physics::Vec2;
@@ -1022,6 +1023,117 @@ mod tests {
         assert!((x[1] - 1.0).abs() < 1e-5, "{x:?}");
         assert!(x[2 + 4].abs() < 1e-5, "{x:?}");
         assert_eq!(one_frame(&walls, 10.0).err(), Some(NotStaged::NotAChain));
+    }
+
+    /// Numbers in `[-1, 1)` from a fixed seed (a linear congruential generator).
+    fn numbers(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        }
+    }
+
+    #[test]
+    fn a_bound_row_adds_and_reads_as_the_full_row_it_stands_for() {
+        // The bound rows take a short way in `add_to` and `row_value`; the row written out in full
+        // (its one entry in `d`, no `bound`) must give the same numbers.
+        let mut next = numbers(7);
+        let frame = frame_without_walls(
+            &StagedProblem::new(&curved_chain().0, &curved_chain().1, &[]),
+            1,
+            None,
+        );
+        for at in 0..MAX_FRAME_VARS {
+            for sign in [1.0, -1.0] {
+                let bound = Row::bound(at, sign, next());
+                let full = Row {
+                    bound: None,
+                    ..bound
+                };
+                let dx: [f64; 4] = std::array::from_fn(|_| next());
+                let v: [f64; MAX_FRAME_VARS] = std::array::from_fn(|_| next());
+                let weight = next();
+                let mut g_bound: [f64; 4 + MAX_FRAME_VARS] = std::array::from_fn(|_| next());
+                let mut g_full = g_bound;
+                bound.add_to(&mut g_bound, weight);
+                full.add_to(&mut g_full, weight);
+                assert_eq!(g_bound, g_full, "row {at}, sign {sign}");
+                if at < frame.nv() {
+                    assert_eq!(
+                        frame.row_value(&bound, &dx, &v),
+                        frame.row_value(&full, &dx, &v)
+                    );
+                }
+            }
+        }
+    }
+
+    /// A chain of two frames with random Jacobians, both controls free, and a curvature block on each:
+    /// the sub-problem and its layout.
+    fn curved_chain() -> (SubProblem<'static>, Layout) {
+        let mut next = numbers(11);
+        let jacobians: &'static [FrameJacobian] =
+            Box::leak(Box::new(std::array::from_fn::<_, 2, _>(|_| {
+                FrameJacobian {
+                    a: std::array::from_fn(|_| std::array::from_fn(|_| next())),
+                    b: std::array::from_fn(|_| std::array::from_fn(|_| next())),
+                }
+            })));
+        let curvature: &'static [CurvatureBlock] =
+            Box::leak(Box::new(std::array::from_fn::<CurvatureBlock, 2, _>(
+                |_| std::array::from_fn(|_| std::array::from_fn(|_| next())),
+            )));
+        let sp = SubProblem {
+            jacobians,
+            positions: Box::leak(Box::new([Vec2::new(5.0, 0.0), Vec2::new(6.0, 0.0)])),
+            walls: &[],
+            margin: 0.0,
+            accepted_clearance: 0.0,
+            slack_weight: 100.0,
+            progress_dir: Vec2::new(1.0, 0.0),
+            sigma_range: &[(1.0, 1.0), (1.0, 1.0)],
+            c_range: &[(C_SCALE_UPS, C_SCALE_UPS), (C_SCALE_UPS, C_SCALE_UPS)],
+            curvature: Some(curvature),
+            wall_shift: None,
+            solver: SubProblemSolver::Riccati,
+        };
+        let layout = Layout::of(&sp);
+        (sp, layout)
+    }
+
+    #[test]
+    fn a_frames_cost_is_curved_in_its_speed_heading_and_controls_only() {
+        // The cost gradient skips the Hessian's first `CURVED_FROM` rows and columns (the position
+        // enters a frame linearly): they must be zero, and the gradient the full product `H z + g`.
+        let (sp, layout) = curved_chain();
+        let problem = StagedProblem::new(&sp, &layout, &[]);
+        let mut next = numbers(13);
+        for k in 0..2 {
+            let frame = frame_without_walls(&problem, k, None);
+            let n = 4 + frame.nv();
+            for i in 0..n {
+                for j in 0..CURVED_FROM {
+                    assert_eq!(frame.hessian[i][j], 0.0, "frame {k}, entry ({i}, {j})");
+                    assert_eq!(frame.hessian[j][i], 0.0, "frame {k}, entry ({j}, {i})");
+                }
+            }
+            // The curvature block lands on the speed, heading and controls of frames after the first.
+            if k > 0 {
+                assert!(frame.hessian[2][2] != 0.0 && frame.hessian[3][4] != 0.0);
+            }
+            let dx: [f64; 4] = std::array::from_fn(|_| next());
+            let v: [f64; MAX_FRAME_VARS] = std::array::from_fn(|_| next());
+            let z = joined(&dx, &v);
+            let full: Vec<f64> = (0..n)
+                .map(|i| {
+                    frame.gradient[i] + (0..n).map(|j| frame.hessian[i][j] * z[j]).sum::<f64>()
+                })
+                .collect();
+            assert_eq!(frame.cost_gradient(&dx, &v)[..n], full[..]);
+        }
     }
 
     #[test]
