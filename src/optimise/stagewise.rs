@@ -1041,11 +1041,8 @@ mod tests {
         // The bound rows take a short way in `add_to` and `row_value`; the row written out in full
         // (its one entry in `d`, no `bound`) must give the same numbers.
         let mut next = numbers(7);
-        let frame = frame_without_walls(
-            &StagedProblem::new(&curved_chain().0, &curved_chain().1, &[]),
-            1,
-            None,
-        );
+        let (sp, layout) = curved_chain();
+        let frame = frame_without_walls(&StagedProblem::new(&sp, &layout, &[]), 1, None);
         for at in 0..MAX_FRAME_VARS {
             for sign in [1.0, -1.0] {
                 let bound = Row::bound(at, sign, next());
