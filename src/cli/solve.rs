@@ -4,7 +4,7 @@ use super::args::SolveArgs;
 use super::{progress, write_artifacts_within};
 use crate::budget::{Budget, Stage};
 use crate::error::{Error, Result};
-use crate::optimise::search::{self, time_limit};
+use crate::optimise::search::{self, time_limit, Progress};
 use crate::optimise::{Outcome, Quality, SearchSettings, SearchStatus, CERTIFIED_CLEARANCE_UNITS};
 use crate::scene::Scene;
 use serde_json::{json, Value};
@@ -32,35 +32,22 @@ pub fn run(args: &SolveArgs) -> Result<String> {
     bar.set_message("lower bound, greedy strafer over look-aheads and speed caps");
     let mut counts_tried = 0u64;
     let outcome = search::solve_with_progress(&scene, &settings, &mut |p| match p {
-        search::Progress::Baseline {
-            greedy_frames,
-            bound_frames,
-        } => {
+        Progress::Baseline { .. } => {
             bar.set_prefix(Stage::Relaxed.name());
-            bar.set_message(format!(
-                "greedy {}, lower bound frame {bound_frames}",
-                greedy_frames.map_or("did not finish".to_string(), |f| format!("frame {f}"))
-            ));
+            bar.set_message(p.to_string());
         }
-        search::Progress::FrameCount { frames, reached } => {
+        Progress::FrameCount { frames, reached } => {
+            // The count of counts tried so far, which the report itself does not carry.
             counts_tried += 1;
             bar.set_prefix(Stage::Relaxed.name());
             bar.set_message(format!(
                 "frame counts tried {counts_tried}, last {frames}: {}",
-                reached.map_or("not reached".to_string(), |r| format!(
-                    "crosses in frame {r}"
-                ))
+                Progress::crossing_text(reached)
             ));
         }
-        search::Progress::Finishing => {
+        Progress::Finishing | Progress::Polishing { .. } => {
             bar.set_prefix(Stage::Rounding.name());
-            bar.set_message("rounding sides, polishing, checking in engine-exact mode");
-        }
-        search::Progress::Polishing { margin_units } => {
-            bar.set_prefix(Stage::Rounding.name());
-            bar.set_message(format!(
-                "polishing the plan on at a wall margin of {margin_units} units"
-            ));
+            bar.set_message(p.to_string());
         }
     });
     bar.finish_and_clear();

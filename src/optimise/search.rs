@@ -326,6 +326,51 @@ pub enum Progress {
     },
 }
 
+impl Progress {
+    /// Where a tried frame count's plan crosses the line, in words (`reached` of
+    /// [`Progress::FrameCount`]).
+    pub fn crossing_text(reached: Option<usize>) -> String {
+        reached.map_or("not reached".to_string(), |r| {
+            format!("crosses in frame {r}")
+        })
+    }
+}
+
+/// The report in words, as a progress display shows it.
+impl std::fmt::Display for Progress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Progress::Baseline {
+                greedy_frames,
+                bound_frames,
+            } => {
+                let greedy =
+                    greedy_frames.map_or("did not finish".to_string(), |g| format!("frame {g}"));
+                write!(f, "greedy {greedy}, lower bound frame {bound_frames}")
+            }
+            Progress::FrameCount { frames, reached } => {
+                write!(
+                    f,
+                    "trying {frames} frames: {}",
+                    Progress::crossing_text(*reached)
+                )
+            }
+            Progress::Finishing => {
+                write!(
+                    f,
+                    "rounding sides, polishing, checking in engine-exact mode"
+                )
+            }
+            Progress::Polishing { margin_units } => {
+                write!(
+                    f,
+                    "polishing the plan on at a wall margin of {margin_units} units"
+                )
+            }
+        }
+    }
+}
+
 /// The minimal-time plan of `scene` (see the module documentation). Errors only for bad input or a scene
 /// with no valid path ([`Error::NoValidPath`]); everything else is a [`SearchStatus`].
 pub fn solve(scene: &Scene, settings: &SearchSettings) -> Result<Outcome> {
@@ -565,6 +610,44 @@ pub fn time_limit(seconds: f64) -> Result<Duration> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn each_progress_report_reads_with_its_own_figures() {
+        let said = [
+            Progress::Baseline {
+                greedy_frames: Some(412),
+                bound_frames: 398,
+            },
+            Progress::Baseline {
+                greedy_frames: None,
+                bound_frames: 398,
+            },
+            Progress::FrameCount {
+                frames: 405,
+                reached: Some(403),
+            },
+            Progress::FrameCount {
+                frames: 402,
+                reached: None,
+            },
+            Progress::Finishing,
+            Progress::Polishing {
+                margin_units: 0.002,
+            },
+        ]
+        .map(|p| p.to_string());
+        assert_eq!(
+            said,
+            [
+                "greedy frame 412, lower bound frame 398",
+                "greedy did not finish, lower bound frame 398",
+                "trying 405 frames: crosses in frame 403",
+                "trying 402 frames: not reached",
+                "rounding sides, polishing, checking in engine-exact mode",
+                "polishing the plan on at a wall margin of 0.002 units",
+            ]
+        );
+    }
 
     #[test]
     fn every_level_searches_as_fast_and_each_dearer_one_polishes_on_closer_to_the_walls() {

@@ -194,7 +194,7 @@ impl Solver {
                 run_solve(
                     &job.scene,
                     &job.settings,
-                    &mut |p| self.lock().stage = stage_text(&p),
+                    &mut |p| self.lock().stage = p.to_string(),
                     &cancel,
                 )
             }));
@@ -249,29 +249,6 @@ pub fn run_solve(
         },
         cancel,
     )
-}
-
-/// A progress report in words.
-fn stage_text(p: &Progress) -> String {
-    match p {
-        Progress::Baseline {
-            greedy_frames,
-            bound_frames,
-        } => format!(
-            "greedy {}, lower bound frame {bound_frames}",
-            greedy_frames.map_or("did not finish".to_string(), |f| format!("frame {f}"))
-        ),
-        Progress::FrameCount { frames, reached } => format!(
-            "trying {frames} frames: {}",
-            reached.map_or("not reached".to_string(), |r| format!(
-                "crosses in frame {r}"
-            ))
-        ),
-        Progress::Finishing => "rounding sides, polishing, checking in engine-exact mode".into(),
-        Progress::Polishing { margin_units } => {
-            format!("polishing the plan on at a wall margin of {margin_units} units")
-        }
-    }
 }
 
 /// The name of a quality level as the page and the command line write it.
