@@ -361,6 +361,9 @@ struct Iterate {
     lambda: Vec<f64>,
     /// Per row, `G z + t - h`; a step of length `alpha` scales it by `1 - alpha` (the rows are linear).
     rp: Vec<f64>,
+    /// Per frame, its cost's gradient `H z + g` at the iterate ([`Frame::cost_gradient`]): kept with the
+    /// variables, as every pass of an iteration reads it.
+    grad: Vec<[f64; 4 + MAX_FRAME_VARS]>,
 }
 
 /// A frame's part of the Newton system's factorisation.
@@ -590,6 +593,7 @@ fn primal_residual(frames: &[Frame], offsets: &[usize], it: &Iterate) -> Vec<f64
 fn centred(frames: &[Frame]) -> Iterate {
     let mut v = Vec::with_capacity(frames.len());
     let mut dx = Vec::with_capacity(frames.len());
+    let mut grad = Vec::with_capacity(frames.len());
     let mut t = Vec::new();
     let mut before = [0.0; 4];
     for f in frames {
@@ -607,6 +611,7 @@ fn centred(frames: &[Frame]) -> Iterate {
             vk[at] = worst + 1.0;
         }
         t.extend(f.rows.iter().map(|_| 1.0));
+        grad.push(f.cost_gradient(&before, &vk));
         let after = f.step(&before, &vk);
         v.push(vk);
         dx.push(after);
@@ -620,6 +625,7 @@ fn centred(frames: &[Frame]) -> Iterate {
         t,
         lambda,
         rp,
+        grad,
     }
 }
 
@@ -650,7 +656,7 @@ fn stationarity(p: &StagedProblem, frames: &[Frame], offsets: &[usize], it: &Ite
     let mut adjoint = p.terminal_gradient;
     let mut largest = 0.0_f64;
     for (k, f) in frames.iter().enumerate().rev() {
-        let mut grad = f.cost_gradient(&before(it, k), &it.v[k]);
+        let mut grad = it.grad[k];
         for (r, row) in f.rows.iter().enumerate() {
             row.add_to(&mut grad, it.lambda[offsets[k] + r]);
         }
@@ -750,8 +756,7 @@ fn direction(
     let mut cost_to_go = p.terminal_gradient;
     for (k, f) in frames.iter().enumerate().rev() {
         let nv = f.nv();
-        let xb = before(it, k);
-        let mut g = f.cost_gradient(&xb, &it.v[k]);
+        let mut g = it.grad[k];
         for (r, row) in f.rows.iter().enumerate() {
             let i = offsets[k] + r;
             row.add_to(
@@ -826,6 +831,7 @@ fn take_step(frames: &[Frame], it: &mut Iterate, dir: &Direction, alpha: f64) {
     }
     let mut x = [0.0; 4];
     for (k, f) in frames.iter().enumerate() {
+        it.grad[k] = f.cost_gradient(&x, &it.v[k]);
         x = f.step(&x, &it.v[k]);
         it.dx[k] = x;
     }
@@ -928,8 +934,7 @@ fn solution(
             }
         } else {
             // The next frame's cost in its incoming state (its constant gradient has no state part).
-            let g = frames[k + 1].cost_gradient(&it.dx[k], &it.v[k + 1]);
-            for (d, gi) in direct.iter_mut().zip(&g) {
+            for (d, gi) in direct.iter_mut().zip(&it.grad[k + 1]) {
                 *d += gi;
             }
         }
@@ -1130,6 +1135,34 @@ mod tests {
                 })
                 .collect();
             assert_eq!(frame.cost_gradient(&dx, &v)[..n], full[..]);
+        }
+    }
+
+    #[test]
+    fn an_iterate_keeps_the_cost_gradients_of_its_variables_through_its_steps() {
+        // Every pass of an iteration reads the frames' cost gradients from the iterate: from the start
+        // and after each step they must be those of its variables and of the states the step played.
+        let (sp, layout) = curved_chain();
+        let problem = StagedProblem::new(&sp, &layout, &[]);
+        let (frames, _) = frames_of(&problem).unwrap_or_else(|e| panic!("{e:?}"));
+        let mut it = centred(&frames);
+        let mut next = numbers(17);
+        for step in 0..3 {
+            if step > 0 {
+                let dir = Direction {
+                    dv: frames
+                        .iter()
+                        .map(|_| std::array::from_fn(|_| next()))
+                        .collect(),
+                    dt: vec![0.0; it.t.len()],
+                    dlambda: vec![0.0; it.t.len()],
+                };
+                take_step(&frames, &mut it, &dir, 0.5);
+            }
+            for (k, f) in frames.iter().enumerate() {
+                let fresh = f.cost_gradient(&before(&it, k), &it.v[k]);
+                assert_eq!(it.grad[k], fresh, "step {step}, frame {k}");
+            }
         }
     }
 
