@@ -21,6 +21,7 @@ use super::planner::Planner;
 use super::polish::{polished_again, rounded_and_polished, MARGIN_RETRIES};
 use super::relaxed::{
     count_search, relaxed_plan, Certifier, CountSearch, Descent, Relaxation, StartKind,
+    CERTIFICATE_MARGIN_UNITS,
 };
 use super::scp::StageKind;
 use super::search::{FinePolish, Progress, SearchSettings};
@@ -31,6 +32,10 @@ use crate::sim::Trace;
 /// ([`best_plan_polished_on`]): a round over a few thousand frames costs seconds (docs/design.md, "The
 /// final polish").
 const FINAL_POLISH_MIN_GAIN_FRAMES: f64 = 0.01;
+
+/// Steps in which a certificate's line is widened from the certificate's margin to the planning margin
+/// where the count search cannot reach the finish line from it at once ([`widened_in_steps`]).
+const WIDENING_STEPS: usize = 4;
 
 /// Final wall margins tried, as multiples of the setting, until a plan stays valid.
 const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
@@ -281,9 +286,57 @@ fn plans_of_certificate_line(
         None => Widening::FinalMarginAndLine,
     };
     let planning = terms.margins.planning;
-    if let Some(source) = refined(planner, progress, line, terms.lo, planning, widening) {
+    let source = refined(
+        planner,
+        progress,
+        line.clone(),
+        terms.lo,
+        planning,
+        widening,
+    )
+    .or_else(|| widened_in_steps(planner, progress, line, terms.lo, planning, widening));
+    if let Some(source) = source {
         exact_plans(planner, &source, terms.greedy_s, best);
     }
+}
+
+/// `line`, a line of the certificate's problem (at [`CERTIFICATE_MARGIN_UNITS`]) that the count search
+/// could not refine at `margin` (units) at once, refined towards it in [`WIDENING_STEPS`] even steps of
+/// the margin, each count search frame by frame from the line of the one before, as a line to round with
+/// `widening` at the widest margin reached; `None` if not even the first step reaches the finish line.
+/// Along a wall the certificate's line starts a whole planning margin inside it, and moved out at once
+/// its stage can end short of the line with every step after its first rejected (docs/design.md, "A
+/// certificate's line widened in steps"). A line rounded at a margin under the planning margin can round
+/// into plans that scrape a wall; the replays decide, and the final margin widens as for any
+/// certificate's line.
+fn widened_in_steps(
+    planner: &mut Planner,
+    progress: &mut dyn FnMut(Progress),
+    mut line: Vec<FrameControl>,
+    lo: usize,
+    margin: f64,
+    widening: Widening,
+) -> Option<Source> {
+    let mut reached = None;
+    for step in 1..=WIDENING_STEPS {
+        let share = step as f64 / WIDENING_STEPS as f64;
+        let step_margin = CERTIFICATE_MARGIN_UNITS + share * (margin - CERTIFICATE_MARGIN_UNITS);
+        let n = line.len();
+        let search = CountSearch::per_frame(Relaxation::planning(step_margin));
+        match count_search(planner, progress, line.clone(), n, lo, search).line {
+            Some(widened) => {
+                line = widened;
+                reached = Some(step_margin);
+            }
+            None => break,
+        }
+    }
+    let margin = reached?;
+    Some(Source {
+        line,
+        margin,
+        widening,
+    })
 }
 
 /// `line` refined by the count search at `margin` (units), frame by frame, as a line to round with
