@@ -305,7 +305,7 @@ fn plans_of_certificate_line(
 /// the margin, each count search frame by frame from the line of the one before, as a line to round with
 /// `widening` at the widest margin reached; `None` if not even the first step reaches the finish line.
 /// Along a wall the certificate's line starts a whole planning margin inside it, and moved out at once
-/// its stage can end short of the line with every step after its first rejected (docs/design.md, "A
+/// its stage can stall short of the finish line, its later steps rejected (docs/design.md, "A
 /// certificate's line widened in steps"). A line rounded at a margin under the planning margin can round
 /// into plans that scrape a wall; the replays decide, and the final margin widens as for any
 /// certificate's line.
