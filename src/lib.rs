@@ -20,4 +20,7 @@ pub mod serve;
 pub mod sim;
 pub mod work;
 
+#[cfg(test)]
+mod test_stream;
+
 pub use error::{Error, Result};

@@ -203,6 +203,7 @@ impl Corridor {
 mod tests {
     use super::*;
     use crate::geometry::Wall;
+    use crate::test_stream::Stream;
 
     fn corridor() -> Corridor {
         // One horizontal rule line along y = 0 from x = 0 to 100, and a square post at (200, 50).
@@ -229,13 +230,8 @@ mod tests {
     #[test]
     fn clearance_matches_sampled_points_and_planes_separate() {
         let c = corridor();
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut stream = Stream(7);
+        let mut rnd = || stream.next();
         for _ in 0..2000 {
             let p0 = Vec2::new(rnd() * 300.0 - 20.0, rnd() * 120.0 - 30.0);
             let p1 = p0 + Vec2::new(rnd() * 40.0 - 20.0, rnd() * 40.0 - 20.0);

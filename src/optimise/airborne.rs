@@ -312,31 +312,22 @@ fn plans_of_certificate_line(
 fn widened_in_steps(
     planner: &mut Planner,
     progress: &mut dyn FnMut(Progress),
-    mut line: Vec<FrameControl>,
+    line: Vec<FrameControl>,
     lo: usize,
     margin: f64,
     widening: Widening,
 ) -> Option<Source> {
-    let mut reached = None;
+    let mut widest: Option<Source> = None;
     for step in 1..=WIDENING_STEPS {
         let share = step as f64 / WIDENING_STEPS as f64;
         let step_margin = CERTIFICATE_MARGIN_UNITS + share * (margin - CERTIFICATE_MARGIN_UNITS);
-        let n = line.len();
-        let search = CountSearch::per_frame(Relaxation::planning(step_margin));
-        match count_search(planner, progress, line.clone(), n, lo, search).line {
-            Some(widened) => {
-                line = widened;
-                reached = Some(step_margin);
-            }
+        let from = widest.as_ref().map_or(&line, |w| &w.line).clone();
+        match refined(planner, progress, from, lo, step_margin, widening) {
+            Some(wider) => widest = Some(wider),
             None => break,
         }
     }
-    let margin = reached?;
-    Some(Source {
-        line,
-        margin,
-        widening,
-    })
+    widest
 }
 
 /// `line` refined by the count search at `margin` (units), frame by frame, as a line to round with

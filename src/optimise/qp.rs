@@ -723,6 +723,7 @@ mod tests {
     use super::*;
     use crate::geometry::HalfPlane;
     use crate::physics::Vec2;
+    use crate::test_stream::Stream;
 
     /// One frame moving along +x; progress along +x; a wall row keeping the end position at y <= 0.
     fn one_frame(
@@ -991,23 +992,6 @@ mod tests {
             );
             // It uses the whole sideways range to reduce the violation: sigma moves y by -0.01.
             assert!((r.du[0].0 + 1.0).abs() < 1e-6, "{:?}", r.du);
-        }
-    }
-
-    /// A deterministic stream of numbers in [0, 1) (a linear congruential generator).
-    struct Stream(u64);
-
-    impl Stream {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-
-        fn within(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.next()
         }
     }
 

@@ -969,6 +969,7 @@ mod tests {
     use crate::optimise::model::FrameJacobian;
     use crate::optimise::qp::{SubProblemSolver, WallRow, C_SCALE_UPS};
     use crate::physics::Vec2;
+    use crate::test_stream::Stream;
 
     /// One frame that carries the state over, its side moving the end position along `y` and its `c`
     /// along `x` (progress), both within a unit box (scaled); the wall rows `walls` on frame 0, each
@@ -1030,15 +1031,10 @@ mod tests {
         assert_eq!(one_frame(&walls, 10.0).err(), Some(NotStaged::NotAChain));
     }
 
-    /// Numbers in `[-1, 1)` from a fixed seed (a linear congruential generator).
+    /// Numbers in `[-1, 1)` from a fixed seed.
     fn numbers(seed: u64) -> impl FnMut() -> f64 {
-        let mut state = seed;
-        move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        }
+        let mut stream = Stream(seed);
+        move || stream.within(-1.0, 1.0)
     }
 
     #[test]
