@@ -37,6 +37,11 @@ const FINAL_POLISH_MIN_GAIN_FRAMES: f64 = 0.01;
 /// where the count search cannot reach the finish line from it at once ([`widened_in_steps`]).
 const WIDENING_STEPS: usize = 4;
 
+/// Most rounds of a certificate's line faster than the plan, each from the plan of the one before
+/// ([`certificate_lines_rounded_while_ahead`]): a bound on the work, not tuned (the one scene known to
+/// take a second round stops after its third, its certificate no faster).
+const CERTIFICATE_LINE_ROUNDS: usize = 4;
+
 /// Final wall margins tried, as multiples of the setting, until a plan stays valid.
 const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
 
@@ -189,8 +194,14 @@ pub(super) fn plan_airborne(
         None => plan_as_certificate_start(planner, &mut certifier, &best, lo, progress),
     };
     if let Some(line) = faster_line {
-        plans_of_certificate_line(planner, line, terms, progress, &mut best);
-        plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
+        certificate_lines_rounded_while_ahead(
+            planner,
+            &mut certifier,
+            line,
+            terms,
+            progress,
+            &mut best,
+        );
     }
     if failed_plan_polished_wider(planner, greedy_s, &mut best) {
         plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
@@ -203,6 +214,53 @@ pub(super) fn plan_airborne(
         certifier,
         relaxed_found: true,
     }
+}
+
+/// `line`, a line of the certificate's problem faster than the plan, rounded; the plan that comes of it
+/// is the certificate's start again, and where the line descended from it is the certificate's fastest,
+/// a frame or more ahead of the plan, and the round made the plan faster, that line is rounded in turn,
+/// for at most [`CERTIFICATE_LINE_ROUNDS`] rounds. A line rounded into a plan a few frames behind it can
+/// lead, from that plan, to a faster line still: the plan starts the certificate nearer the optimum
+/// than the line it came from did (docs/design.md, "The certificate's lines rounded while ahead").
+fn certificate_lines_rounded_while_ahead(
+    planner: &mut Planner,
+    certifier: &mut Certifier,
+    line: Vec<FrameControl>,
+    terms: PlanTerms,
+    progress: &mut dyn FnMut(Progress),
+    best: &mut BestPlan,
+) {
+    let frame_s = planner.fl.tau_s;
+    let mut next = Some(line);
+    for _ in 0..CERTIFICATE_LINE_ROUNDS {
+        let Some(line) = next.take() else {
+            break;
+        };
+        let before_s = best.as_ref().map(|b| b.0);
+        plans_of_certificate_line(planner, line, terms, progress, best);
+        let found = plan_as_certificate_start(planner, certifier, best, terms.lo, progress);
+        let plan_s = best.as_ref().map(|b| b.0);
+        if worth_another_round(before_s, plan_s, certifier.best_time(), frame_s) {
+            next = found;
+        }
+    }
+}
+
+/// Whether a round of [`certificate_lines_rounded_while_ahead`] that took the plan from `before_s` to
+/// `plan_s` (seconds; `None`: no plan) is followed by another: the plan got faster, and the
+/// certificate's fastest line (`certificate_s`) crosses at least a frame (`frame_s`) before it.
+fn worth_another_round(
+    before_s: Option<f64>,
+    plan_s: Option<f64>,
+    certificate_s: Option<f64>,
+    frame_s: f64,
+) -> bool {
+    let Some(plan_s) = plan_s else {
+        return false;
+    };
+    let faster = before_s.is_none_or(|b| plan_s < b);
+    let a_frame_ahead = certificate_s.is_some_and(|c| c + frame_s <= plan_s);
+    faster && a_frame_ahead
 }
 
 /// What the exact plans of a certificate's line are held to: no plan crosses before frame `lo`, each
@@ -663,6 +721,43 @@ mod tests {
     use crate::optimise::search::SearchSettings;
     use crate::optimise::verify::time_of;
     use crate::optimise::Quality;
+
+    #[test]
+    fn a_certificate_line_is_rounded_again_only_after_a_round_that_gained_and_a_frame_behind_it() {
+        let frame = 0.01;
+        // The round made the plan faster, and the certificate is 1.5 frames ahead of it: again.
+        assert!(worth_another_round(
+            Some(5.60),
+            Some(5.55),
+            Some(5.535),
+            frame
+        ));
+        // The first plan of all (none before) a frame behind the certificate: again.
+        assert!(worth_another_round(None, Some(5.55), Some(5.535), frame));
+        // No faster: the same line would be rounded into the same plan.
+        assert!(!worth_another_round(
+            Some(5.55),
+            Some(5.55),
+            Some(5.50),
+            frame
+        ));
+        assert!(!worth_another_round(
+            Some(5.54),
+            Some(5.55),
+            Some(5.50),
+            frame
+        ));
+        // Less than a frame behind the certificate: the final polish's part, not another rounding.
+        assert!(!worth_another_round(
+            Some(5.60),
+            Some(5.55),
+            Some(5.545),
+            frame
+        ));
+        // No certificate, or no plan.
+        assert!(!worth_another_round(Some(5.60), Some(5.55), None, frame));
+        assert!(!worth_another_round(Some(5.60), None, Some(5.50), frame));
+    }
 
     #[test]
     fn a_plan_whose_controls_end_short_of_the_line_starts_the_certificate_as_played() {
