@@ -181,7 +181,8 @@ pub(super) fn plan_airborne(
     }
     // Descending from the plan, the certificate's problem can find a faster line than the relaxed stage
     // did (it stopped short of its optimum, or in a slower basin): that line is rounded too, and the plan
-    // that comes of it is a start again, so that the certificate stays no slower than the plan.
+    // that comes of it is a start again, so that the certificate stays no slower than the plan; a faster
+    // line from that start is rounded in turn while the plan gains and is a frame or more behind it.
     let faster_line = match beside {
         Some(line) => another_line_beside_the_plan_as_start(
             planner,
