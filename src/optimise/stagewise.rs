@@ -156,6 +156,7 @@ impl Row {
     }
 
     /// `g += weight (c, d)`: the row's pull on a frame's gradient at dual `weight`.
+    #[inline]
     fn add_to(&self, g: &mut [f64; 4 + MAX_FRAME_VARS], weight: f64) {
         if let Some(at) = self.bound {
             g[4 + at] += self.d[at] * weight;
@@ -186,14 +187,16 @@ impl Frame {
     }
 
     /// `A dx + B v`.
+    #[inline]
     fn step(&self, dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> [f64; 4] {
-        std::array::from_fn(|i| {
+        array_of(|i| {
             (0..4).map(|j| self.a[i][j] * dx[j]).sum::<f64>()
                 + (0..self.nv()).map(|j| self.b[i][j] * v[j]).sum::<f64>()
         })
     }
 
     /// `c . dx + d . v` of a row.
+    #[inline]
     fn row_value(&self, row: &Row, dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> f64 {
         if let Some(at) = row.bound {
             return row.d[at] * v[at];
@@ -203,10 +206,11 @@ impl Frame {
     }
 
     /// `H z + g` at `z = (dx, v)`.
+    #[inline]
     fn cost_gradient(&self, dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> [f64; 4 + MAX_FRAME_VARS] {
         let z = joined(dx, v);
         let n = 4 + self.nv();
-        std::array::from_fn(|i| {
+        array_of(|i| {
             if i < CURVED_FROM {
                 self.gradient[i]
             } else if i < n {
@@ -225,8 +229,20 @@ impl Frame {
 /// the frame linearly, so the Hessian's first two rows and columns are zero.
 const CURVED_FROM: usize = 2;
 
+/// The array whose entry `i` is `entry(i)`, computed in order. As `std::array::from_fn`, but always
+/// inlined with its closure: the frame-by-frame passes build a few such arrays per frame and iteration,
+/// and `from_fn`'s closures were left as calls there.
+#[inline(always)]
+fn array_of<T: Copy + Default, const N: usize>(mut entry: impl FnMut(usize) -> T) -> [T; N] {
+    let mut out = [T::default(); N];
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = entry(i);
+    }
+    out
+}
+
 fn joined(dx: &[f64; 4], v: &[f64; MAX_FRAME_VARS]) -> [f64; 4 + MAX_FRAME_VARS] {
-    std::array::from_fn(|i| if i < 4 { dx[i] } else { v[i - 4] })
+    array_of(|i| if i < 4 { dx[i] } else { v[i - 4] })
 }
 
 /// Where a row sits: its frame, and its index among the frame's rows.
@@ -378,10 +394,36 @@ struct FrameFactor {
 }
 
 /// A Newton direction.
+#[derive(Default)]
 struct Direction {
     dv: Vec<[f64; MAX_FRAME_VARS]>,
     dt: Vec<f64>,
     dlambda: Vec<f64>,
+    /// Per frame, the feed-forward term of the backward pass that gave it.
+    feed: Vec<[f64; MAX_FRAME_VARS]>,
+}
+
+impl Direction {
+    /// Room for `frames` frames' and `rows` rows' changes (their values are written before they are read).
+    fn sized(&mut self, frames: usize, rows: usize) {
+        self.dv.resize(frames, [0.0; MAX_FRAME_VARS]);
+        self.feed.resize(frames, [0.0; MAX_FRAME_VARS]);
+        self.dt.resize(rows, 0.0);
+        self.dlambda.resize(rows, 0.0);
+    }
+}
+
+/// The buffers of an iteration, kept from one to the next: a solve's sub-problem has thousands of frames,
+/// and every iteration would otherwise allocate and clear them all again.
+#[derive(Default)]
+struct Workspace {
+    factors: Vec<FrameFactor>,
+    /// The affine (predictor) direction and the corrector.
+    affine: Direction,
+    corrector: Direction,
+    /// Per row, the complementarity residuals of the two directions.
+    rc_affine: Vec<f64>,
+    rc: Vec<f64>,
 }
 
 /// Solves `p` within `max_iterations` interior-point iterations and `time_limit_s` seconds.
@@ -402,19 +444,13 @@ pub(super) fn solve(
 ) -> Result<StagedSolution, NotStaged> {
     let clock = std::time::Instant::now();
     let (frames, wall_rows) = frames_of(p)?;
-    let offsets: Vec<usize> = frames
-        .iter()
-        .scan(0, |at, f| {
-            let o = *at;
-            *at += f.rows.len();
-            Some(o)
-        })
-        .collect();
+    let offsets = row_offsets(&frames);
+    let mut work = Workspace::default();
     let mut it = match warm {
         // Every frame's slacks and duals come from the warm start: the cold start's affine step would
         // be overwritten.
         Some(warm) if warm.covers(&frames) => centred(&frames),
-        _ => started(p, &frames, &offsets)?,
+        _ => started(p, &frames, &offsets, &mut work)?,
     };
     if let Some(warm) = warm {
         warm_started(&frames, &offsets, &mut it, warm);
@@ -434,7 +470,7 @@ pub(super) fn solve(
             Met::Almost => almost = true,
             Met::Not => almost = false,
         }
-        mehrotra_step(p, &frames, &offsets, &mut it)?;
+        mehrotra_step(p, &frames, &offsets, &mut it, &mut work)?;
     }
     if almost {
         return Ok(solution(
@@ -448,6 +484,18 @@ pub(super) fn solve(
         ));
     }
     Err(NotStaged::MaxIterations)
+}
+
+/// Per frame, the index of its first row among all rows.
+fn row_offsets(frames: &[Frame]) -> Vec<usize> {
+    frames
+        .iter()
+        .scan(0, |at, f| {
+            let o = *at;
+            *at += f.rows.len();
+            Some(o)
+        })
+        .collect()
 }
 
 /// The tolerances of a solution, scaled to the problem's data.
@@ -511,24 +559,29 @@ fn mehrotra_step(
     frames: &[Frame],
     offsets: &[usize],
     it: &mut Iterate,
+    work: &mut Workspace,
 ) -> Result<(), NotStaged> {
     let m = it.t.len().max(1) as f64;
-    let factors = factorised(frames, offsets, it)?;
-    let rc_aff: Vec<f64> = it.t.iter().zip(&it.lambda).map(|(t, l)| t * l).collect();
-    let aff = direction(p, frames, offsets, &factors, it, &rc_aff)?;
-    let alpha_aff = step_to_boundary(it, &aff, 1.0);
+    factorised(frames, offsets, it, &mut work.factors)?;
+    let rc_aff = &mut work.rc_affine;
+    rc_aff.clear();
+    rc_aff.extend(it.t.iter().zip(&it.lambda).map(|(t, l)| t * l));
+    let aff = &mut work.affine;
+    direction(p, frames, offsets, &work.factors, it, rc_aff, aff)?;
+    let alpha_aff = step_to_boundary(it, aff, 1.0);
     let mu = rc_aff.iter().sum::<f64>() / m;
     let mu_aff = (0..it.t.len())
         .map(|i| (it.t[i] + alpha_aff * aff.dt[i]) * (it.lambda[i] + alpha_aff * aff.dlambda[i]))
         .sum::<f64>()
         / m;
     let sigma = (mu_aff / mu).clamp(0.0, 1.0).powi(3);
-    let rc: Vec<f64> = (0..it.t.len())
-        .map(|i| rc_aff[i] + aff.dt[i] * aff.dlambda[i] - sigma * mu)
-        .collect();
-    let dir = direction(p, frames, offsets, &factors, it, &rc)?;
-    let alpha = step_to_boundary(it, &dir, STEP_TO_BOUNDARY);
-    take_step(frames, it, &dir, alpha);
+    let rc = &mut work.rc;
+    rc.clear();
+    rc.extend((0..it.t.len()).map(|i| rc_aff[i] + aff.dt[i] * aff.dlambda[i] - sigma * mu));
+    let dir = &mut work.corrector;
+    direction(p, frames, offsets, &work.factors, it, rc, dir)?;
+    let alpha = step_to_boundary(it, dir, STEP_TO_BOUNDARY);
+    take_step(frames, it, dir, alpha);
     if it.v.iter().flatten().all(|v| v.is_finite()) {
         Ok(())
     } else {
@@ -539,12 +592,18 @@ fn mehrotra_step(
 /// The first iterate (Mehrotra's, as in Nocedal and Wright, section 16.6): from controls at the centre
 /// of their boxes, slacks one unit above their rows' worst violation and every row's slack and dual at
 /// one, one affine step; then each row's slack and dual is the size that step gives it, at least one.
-fn started(p: &StagedProblem, frames: &[Frame], offsets: &[usize]) -> Result<Iterate, NotStaged> {
+fn started(
+    p: &StagedProblem,
+    frames: &[Frame],
+    offsets: &[usize],
+    work: &mut Workspace,
+) -> Result<Iterate, NotStaged> {
     let mut it = centred(frames);
     it.rp = primal_residual(frames, offsets, &it);
-    let factors = factorised(frames, offsets, &it)?;
+    factorised(frames, offsets, &it, &mut work.factors)?;
     let rc: Vec<f64> = it.t.iter().zip(&it.lambda).map(|(t, l)| t * l).collect();
-    let aff = direction(p, frames, offsets, &factors, &it, &rc)?;
+    let aff = &mut work.affine;
+    direction(p, frames, offsets, &work.factors, &it, &rc, aff)?;
     for (t, dt) in it.t.iter_mut().zip(&aff.dt) {
         *t = (*t + dt).abs().max(1.0);
     }
@@ -664,8 +723,7 @@ fn stationarity(p: &StagedProblem, frames: &[Frame], offsets: &[usize], it: &Ite
             let r = grad[4 + j] + (0..4).map(|i| f.b[i][j] * adjoint[i]).sum::<f64>();
             largest = largest.max(r.abs());
         }
-        adjoint =
-            std::array::from_fn(|j| grad[j] + (0..4).map(|i| f.a[i][j] * adjoint[i]).sum::<f64>());
+        adjoint = array_of(|j| grad[j] + (0..4).map(|i| f.a[i][j] * adjoint[i]).sum::<f64>());
     }
     largest
 }
@@ -676,8 +734,10 @@ fn factorised(
     frames: &[Frame],
     offsets: &[usize],
     it: &Iterate,
-) -> Result<Vec<FrameFactor>, NotStaged> {
-    let mut factors = vec![FrameFactor::default(); frames.len()];
+    factors: &mut Vec<FrameFactor>,
+) -> Result<(), NotStaged> {
+    // Every frame's entry is written below before any is read.
+    factors.resize(frames.len(), FrameFactor::default());
     let mut value = [[0.0; 4]; 4];
     for (k, f) in frames.iter().enumerate().rev() {
         let nv = f.nv();
@@ -699,15 +759,12 @@ fn factorised(
             }
         }
         // P A and P B.
-        let pa: [[f64; 4]; 4] = std::array::from_fn(|i| {
-            std::array::from_fn(|j| (0..4).map(|l| value[i][l] * f.a[l][j]).sum())
-        });
-        let pb: [[f64; MAX_FRAME_VARS]; 4] = std::array::from_fn(|i| {
-            std::array::from_fn(|j| (0..4).map(|l| value[i][l] * f.b[l][j]).sum())
-        });
-        let q_xx: [[f64; 4]; 4] = std::array::from_fn(|i| {
-            std::array::from_fn(|j| h[i][j] + (0..4).map(|l| f.a[l][i] * pa[l][j]).sum::<f64>())
-        });
+        let pa: [[f64; 4]; 4] =
+            array_of(|i| array_of(|j| (0..4).map(|l| value[i][l] * f.a[l][j]).sum()));
+        let pb: [[f64; MAX_FRAME_VARS]; 4] =
+            array_of(|i| array_of(|j| (0..4).map(|l| value[i][l] * f.b[l][j]).sum()));
+        let q_xx: [[f64; 4]; 4] =
+            array_of(|i| array_of(|j| h[i][j] + (0..4).map(|l| f.a[l][i] * pa[l][j]).sum::<f64>()));
         let mut q_vv = [[0.0; MAX_FRAME_VARS]; MAX_FRAME_VARS];
         let mut q_vx = [[0.0; 4]; MAX_FRAME_VARS];
         for i in 0..nv {
@@ -721,22 +778,20 @@ fn factorised(
         let chol = cholesky(&q_vv, nv).ok_or(NotStaged::Numerics)?;
         let mut gain = [[0.0; 4]; MAX_FRAME_VARS];
         for j in 0..4 {
-            let col: [f64; MAX_FRAME_VARS] = std::array::from_fn(|i| q_vx[i][j]);
+            let col: [f64; MAX_FRAME_VARS] = array_of(|i| q_vx[i][j]);
             let s = cholesky_solve(&chol, nv, &col);
             for i in 0..nv {
                 gain[i][j] = -s[i];
             }
         }
         // P = Q_xx + Q_vx' K, kept symmetric.
-        let p: [[f64; 4]; 4] = std::array::from_fn(|i| {
-            std::array::from_fn(|j| {
-                q_xx[i][j] + (0..nv).map(|l| q_vx[l][i] * gain[l][j]).sum::<f64>()
-            })
+        let p: [[f64; 4]; 4] = array_of(|i| {
+            array_of(|j| q_xx[i][j] + (0..nv).map(|l| q_vx[l][i] * gain[l][j]).sum::<f64>())
         });
-        value = std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (p[i][j] + p[j][i])));
+        value = array_of(|i| array_of(|j| 0.5 * (p[i][j] + p[j][i])));
         factors[k] = FrameFactor { chol, q_vx, gain };
     }
-    Ok(factors)
+    Ok(())
 }
 
 /// The Newton direction for complementarity residuals `rc` (`t lambda` minus the target), from the
@@ -749,10 +804,18 @@ fn direction(
     factors: &[FrameFactor],
     it: &Iterate,
     rc: &[f64],
-) -> Result<Direction, NotStaged> {
+    out: &mut Direction,
+) -> Result<(), NotStaged> {
     let rp = &it.rp;
-    // Row i's weight in the gradient: lambda_i + (lambda_i rp_i - rc_i) / t_i.
-    let mut feed = vec![[0.0; MAX_FRAME_VARS]; frames.len()];
+    // Row i's weight in the gradient: lambda_i + (lambda_i rp_i - rc_i) / t_i. Every frame's feed and
+    // every row's change is written below before it is read.
+    out.sized(frames.len(), it.t.len());
+    let Direction {
+        dv,
+        dt,
+        dlambda,
+        feed,
+    } = out;
     let mut cost_to_go = p.terminal_gradient;
     for (k, f) in frames.iter().enumerate().rev() {
         let nv = f.nv();
@@ -764,38 +827,33 @@ fn direction(
                 it.lambda[i] + (it.lambda[i] * rp[i] - rc[i]) / it.t[i],
             );
         }
-        let q_v: [f64; MAX_FRAME_VARS] = std::array::from_fn(|j| {
-            g[4 + j] + (0..4).map(|l| f.b[l][j] * cost_to_go[l]).sum::<f64>()
-        });
+        let q_v: [f64; MAX_FRAME_VARS] =
+            array_of(|j| g[4 + j] + (0..4).map(|l| f.b[l][j] * cost_to_go[l]).sum::<f64>());
         let s = cholesky_solve(&factors[k].chol, nv, &q_v);
-        let kk: [f64; MAX_FRAME_VARS] = std::array::from_fn(|j| -s[j]);
-        cost_to_go = std::array::from_fn(|j| {
+        let kk: [f64; MAX_FRAME_VARS] = array_of(|j| -s[j]);
+        cost_to_go = array_of(|j| {
             g[j] + (0..4).map(|l| f.a[l][j] * cost_to_go[l]).sum::<f64>()
                 + (0..nv).map(|l| factors[k].q_vx[l][j] * kk[l]).sum::<f64>()
         });
         feed[k] = kk;
     }
-    let mut dv = Vec::with_capacity(frames.len());
-    let mut dt = vec![0.0; it.t.len()];
-    let mut dlambda = vec![0.0; it.t.len()];
     let mut dx_before = [0.0; 4];
     for (k, f) in frames.iter().enumerate() {
         let fk = &factors[k];
-        let step: [f64; MAX_FRAME_VARS] = std::array::from_fn(|j| {
-            feed[k][j] + (0..4).map(|l| fk.gain[j][l] * dx_before[l]).sum::<f64>()
-        });
+        let step: [f64; MAX_FRAME_VARS] =
+            array_of(|j| feed[k][j] + (0..4).map(|l| fk.gain[j][l] * dx_before[l]).sum::<f64>());
         for (r, row) in f.rows.iter().enumerate() {
             let i = offsets[k] + r;
             dt[i] = -rp[i] - f.row_value(row, &dx_before, &step);
             dlambda[i] = (-rc[i] - it.lambda[i] * dt[i]) / it.t[i];
         }
         dx_before = f.step(&dx_before, &step);
-        dv.push(step);
+        dv[k] = step;
     }
     if !dx_before.iter().all(|d| d.is_finite()) {
         return Err(NotStaged::Numerics);
     }
-    Ok(Direction { dv, dt, dlambda })
+    Ok(())
 }
 
 /// The longest step up to `share` of the way to the boundary of `t, lambda >= 0`, at most 1.
@@ -864,25 +922,41 @@ fn cholesky(
 }
 
 /// `x` with `L L' x = b` over the leading `n` entries.
+#[inline(always)]
 fn cholesky_solve(
     l: &[[f64; MAX_FRAME_VARS]; MAX_FRAME_VARS],
     n: usize,
     b: &[f64; MAX_FRAME_VARS],
 ) -> [f64; MAX_FRAME_VARS] {
-    // Plain loops: the sums' closures were not inlined here, and this runs per frame and column.
+    // One copy per size: with the size fixed the loops unroll, and the solves of a frame's columns,
+    // each a chain of divisions, can overlap.
+    match n {
+        0 => [0.0; MAX_FRAME_VARS],
+        1 => cholesky_solve_sized::<1>(l, b),
+        2 => cholesky_solve_sized::<2>(l, b),
+        _ => cholesky_solve_sized::<MAX_FRAME_VARS>(l, b),
+    }
+}
+
+/// [`cholesky_solve`] over the leading `N` entries.
+#[inline(always)]
+fn cholesky_solve_sized<const N: usize>(
+    l: &[[f64; MAX_FRAME_VARS]; MAX_FRAME_VARS],
+    b: &[f64; MAX_FRAME_VARS],
+) -> [f64; MAX_FRAME_VARS] {
     let mut y = [0.0; MAX_FRAME_VARS];
-    for i in 0..n {
+    for i in 0..N {
         let mut sum = 0.0;
-        for (lik, yk) in l[i][..i].iter().zip(&y[..i]) {
-            sum += lik * yk;
+        for k in 0..i {
+            sum += l[i][k] * y[k];
         }
         y[i] = (b[i] - sum) / l[i][i];
     }
     let mut x = [0.0; MAX_FRAME_VARS];
-    for i in (0..n).rev() {
+    for i in (0..N).rev() {
         let mut sum = 0.0;
-        for (lk, xk) in l[i + 1..n].iter().zip(&x[i + 1..n]) {
-            sum += lk[i] * xk;
+        for k in i + 1..N {
+            sum += l[k][i] * x[k];
         }
         x[i] = (y[i] - sum) / l[i][i];
     }
@@ -943,9 +1017,7 @@ fn solution(
         } else {
             [[0.0; 4]; 4]
         };
-        adjoint = std::array::from_fn(|j| {
-            direct[j] + (0..4).map(|i| next_a[i][j] * adjoint[i]).sum::<f64>()
-        });
+        adjoint = array_of(|j| direct[j] + (0..4).map(|i| next_a[i][j] * adjoint[i]).sum::<f64>());
         duals[k] = adjoint.map(|a| -a);
     }
     StagedSolution {
@@ -1005,6 +1077,39 @@ mod tests {
             time_limit_s,
             None,
         )
+    }
+
+    /// Three frames as [`one_frame`]'s, each with a wall of its own (rows on the frame's end position).
+    fn walled_chain() -> (SubProblem<'static>, Layout) {
+        let mut a = [[0.0; 4]; 4];
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] = 1.0;
+        }
+        let jacobian = FrameJacobian {
+            a,
+            b: [[0.0, 1.0 / C_SCALE_UPS], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
+        };
+        let walls: &'static [WallRow] =
+            Box::leak(Box::new(std::array::from_fn::<_, 3, _>(|k| WallRow {
+                frame: k,
+                ..wall(k)
+            })));
+        let sp = SubProblem {
+            jacobians: Box::leak(Box::new([jacobian; 3])),
+            positions: Box::leak(Box::new([5.0, 6.0, 7.0].map(|x| Vec2::new(x, 0.0)))),
+            walls,
+            margin: 0.0,
+            accepted_clearance: 0.0,
+            slack_weight: 100.0,
+            progress_dir: Vec2::new(1.0, 0.0),
+            sigma_range: &[(1.0, 1.0); 3],
+            c_range: &[(C_SCALE_UPS, C_SCALE_UPS); 3],
+            curvature: None,
+            wall_shift: None,
+            solver: SubProblemSolver::Riccati,
+        };
+        let layout = Layout::of(&sp);
+        (sp, layout)
     }
 
     /// A wall keeping the end position at `y <= 0.5` (the row `-n . dp - s <= 0.5`, `n = (0, -1)`).
@@ -1152,6 +1257,7 @@ mod tests {
                         .collect(),
                     dt: vec![0.0; it.t.len()],
                     dlambda: vec![0.0; it.t.len()],
+                    feed: Vec::new(),
                 };
                 take_step(&frames, &mut it, &dir, 0.5);
             }
@@ -1160,6 +1266,59 @@ mod tests {
                 assert_eq!(it.grad[k], fresh, "step {step}, frame {k}");
             }
         }
+    }
+
+    #[test]
+    fn a_factorisation_and_a_direction_into_used_buffers_are_those_into_fresh_ones() {
+        // The buffers are kept from one iteration to the next and every entry must be written again:
+        // used buffers hold NaN (which equals nothing) and are longer than the problem needs.
+        let (sp, layout) = walled_chain();
+        let rhs = vec![0.5; sp.walls.len()];
+        let problem = StagedProblem::new(&sp, &layout, &rhs);
+        let (frames, _) = frames_of(&problem).unwrap_or_else(|e| panic!("{e:?}"));
+        let offsets = row_offsets(&frames);
+        let mut it = centred(&frames);
+        it.rp = primal_residual(&frames, &offsets, &it);
+        let (n, rows) = (frames.len(), it.t.len());
+        let nan_vars = [f64::NAN; MAX_FRAME_VARS];
+        let stale = FrameFactor {
+            chol: [nan_vars; MAX_FRAME_VARS],
+            q_vx: [[f64::NAN; 4]; MAX_FRAME_VARS],
+            gain: [[f64::NAN; 4]; MAX_FRAME_VARS],
+        };
+        let mut fresh_factors = Vec::new();
+        let mut used_factors = vec![stale; n + 2];
+        for factors in [&mut fresh_factors, &mut used_factors] {
+            factorised(&frames, &offsets, &it, factors).unwrap_or_else(|e| panic!("{e:?}"));
+        }
+        assert_eq!(used_factors.len(), n);
+        for (a, b) in fresh_factors.iter().zip(&used_factors) {
+            assert_eq!((a.chol, a.q_vx, a.gain), (b.chol, b.q_vx, b.gain));
+        }
+        let rc: Vec<f64> =
+            it.t.iter()
+                .zip(&it.lambda)
+                .map(|(t, l)| 0.5 * t * l)
+                .collect();
+        let mut fresh = Direction::default();
+        let mut used = Direction {
+            dv: vec![nan_vars; n + 3],
+            dt: vec![f64::NAN; rows + 3],
+            dlambda: vec![f64::NAN; rows + 3],
+            feed: vec![nan_vars; n + 3],
+        };
+        for dir in [&mut fresh, &mut used] {
+            direction(&problem, &frames, &offsets, &fresh_factors, &it, &rc, dir)
+                .unwrap_or_else(|e| panic!("{e:?}"));
+        }
+        assert_eq!(fresh.dv, used.dv);
+        assert_eq!(fresh.dt, used.dt);
+        assert_eq!(fresh.dlambda, used.dlambda);
+        assert_eq!(fresh.feed, used.feed);
+        assert!(
+            fresh.dv.iter().flatten().any(|d| *d != 0.0),
+            "a direction that moves"
+        );
     }
 
     #[test]
