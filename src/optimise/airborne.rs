@@ -205,10 +205,10 @@ pub(super) fn plan_airborne(
         );
     }
     if failed_plan_polished_wider(planner, greedy_s, &mut best) {
-        plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
+        polished_plan_as_certificate_start(planner, &mut certifier, terms, progress, &mut best);
     }
     if best_plan_polished_on(planner, greedy_s, &mut best) {
-        plan_as_certificate_start(planner, &mut certifier, &best, lo, progress);
+        polished_plan_as_certificate_start(planner, &mut certifier, terms, progress, &mut best);
     }
     AirbornePlan {
         best,
@@ -260,8 +260,34 @@ fn worth_another_round(
         return false;
     };
     let faster = before_s.is_none_or(|b| plan_s < b);
-    let a_frame_ahead = certificate_s.is_some_and(|c| c + frame_s <= plan_s);
-    faster && a_frame_ahead
+    faster && a_frame_ahead(certificate_s, plan_s, frame_s)
+}
+
+/// Whether the certificate's fastest line (`certificate_s`, seconds; `None`: no line) crosses at least a
+/// frame (`frame_s`) before the plan (`plan_s`).
+fn a_frame_ahead(certificate_s: Option<f64>, plan_s: f64, frame_s: f64) -> bool {
+    certificate_s.is_some_and(|c| c + frame_s <= plan_s)
+}
+
+/// A plan a polish made faster, the certificate's start again ([`plan_as_certificate_start`]); where the
+/// line the certificate descends to from it crosses a frame or more before the plan, that line is
+/// rounded in turn, and so on while ahead ([`certificate_lines_rounded_while_ahead`]). A faster line
+/// within the plan's frame is left: closing less than a frame is the polishes' part.
+fn polished_plan_as_certificate_start(
+    planner: &mut Planner,
+    certifier: &mut Certifier,
+    terms: PlanTerms,
+    progress: &mut dyn FnMut(Progress),
+    best: &mut BestPlan,
+) {
+    let Some(line) = plan_as_certificate_start(planner, certifier, best, terms.lo, progress) else {
+        return;
+    };
+    let frame_s = planner.fl.tau_s;
+    let plan_s = best.as_ref().map(|b| b.0);
+    if plan_s.is_some_and(|p| a_frame_ahead(certifier.best_time(), p, frame_s)) {
+        certificate_lines_rounded_while_ahead(planner, certifier, line, terms, progress, best);
+    }
 }
 
 /// What the exact plans of a certificate's line are held to: no plan crosses before frame `lo`, each
@@ -679,7 +705,13 @@ pub(super) fn plan_polished_finely(
         planner.join(&finer);
     }
     if faster {
-        plan_as_certificate_start(planner, &mut found.certifier, &found.best, lo, progress);
+        let terms = PlanTerms {
+            lo,
+            margins: LineMargins::of(planner),
+            greedy_s,
+        };
+        let (certifier, best) = (&mut found.certifier, &mut found.best);
+        polished_plan_as_certificate_start(planner, certifier, terms, progress, best);
     }
 }
 
