@@ -283,9 +283,12 @@ fn polished_plan_as_certificate_start(
     let Some(line) = plan_as_certificate_start(planner, certifier, best, terms.lo, progress) else {
         return;
     };
+    // A line came back, so there is a plan: the certificate started from it.
     let frame_s = planner.fl.tau_s;
-    let plan_s = best.as_ref().map(|b| b.0);
-    if plan_s.is_some_and(|p| a_frame_ahead(certifier.best_time(), p, frame_s)) {
+    if best
+        .as_ref()
+        .is_some_and(|b| a_frame_ahead(certifier.best_time(), b.0, frame_s))
+    {
         certificate_lines_rounded_while_ahead(planner, certifier, line, terms, progress, best);
     }
 }

@@ -562,12 +562,8 @@ fn mehrotra_step(
     work: &mut Workspace,
 ) -> Result<(), NotStaged> {
     let m = it.t.len().max(1) as f64;
-    factorised(frames, offsets, it, &mut work.factors)?;
-    let rc_aff = &mut work.rc_affine;
-    rc_aff.clear();
-    rc_aff.extend(it.t.iter().zip(&it.lambda).map(|(t, l)| t * l));
-    let aff = &mut work.affine;
-    direction(p, frames, offsets, &work.factors, it, rc_aff, aff)?;
+    affine_direction(p, frames, offsets, it, work)?;
+    let (rc_aff, aff) = (&work.rc_affine, &work.affine);
     let alpha_aff = step_to_boundary(it, aff, 1.0);
     let mu = rc_aff.iter().sum::<f64>() / m;
     let mu_aff = (0..it.t.len())
@@ -589,6 +585,22 @@ fn mehrotra_step(
     }
 }
 
+/// The Newton system factorised at `it`, and its affine direction, which drives every row's `t lambda`
+/// to zero, into `work` (`factors`, `rc_affine`, `affine`).
+fn affine_direction(
+    p: &StagedProblem,
+    frames: &[Frame],
+    offsets: &[usize],
+    it: &Iterate,
+    work: &mut Workspace,
+) -> Result<(), NotStaged> {
+    factorised(frames, offsets, it, &mut work.factors)?;
+    let rc = &mut work.rc_affine;
+    rc.clear();
+    rc.extend(it.t.iter().zip(&it.lambda).map(|(t, l)| t * l));
+    direction(p, frames, offsets, &work.factors, it, rc, &mut work.affine)
+}
+
 /// The first iterate (Mehrotra's, as in Nocedal and Wright, section 16.6): from controls at the centre
 /// of their boxes, slacks one unit above their rows' worst violation and every row's slack and dual at
 /// one, one affine step; then each row's slack and dual is the size that step gives it, at least one.
@@ -600,10 +612,8 @@ fn started(
 ) -> Result<Iterate, NotStaged> {
     let mut it = centred(frames);
     it.rp = primal_residual(frames, offsets, &it);
-    factorised(frames, offsets, &it, &mut work.factors)?;
-    let rc: Vec<f64> = it.t.iter().zip(&it.lambda).map(|(t, l)| t * l).collect();
-    let aff = &mut work.affine;
-    direction(p, frames, offsets, &work.factors, &it, &rc, aff)?;
+    affine_direction(p, frames, offsets, &it, work)?;
+    let aff = &work.affine;
     for (t, dt) in it.t.iter_mut().zip(&aff.dt) {
         *t = (*t + dt).abs().max(1.0);
     }
@@ -1047,29 +1057,7 @@ mod tests {
     /// along `x` (progress), both within a unit box (scaled); the wall rows `walls` on frame 0, each
     /// with the right-hand side 0.5.
     fn one_frame(walls: &[WallRow], time_limit_s: f64) -> Result<StagedSolution, NotStaged> {
-        let mut a = [[0.0; 4]; 4];
-        for (i, row) in a.iter_mut().enumerate() {
-            row[i] = 1.0;
-        }
-        let jacobians = [FrameJacobian {
-            a,
-            b: [[0.0, 1.0 / C_SCALE_UPS], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
-        }];
-        let sp = SubProblem {
-            jacobians: &jacobians,
-            positions: &[Vec2::new(5.0, 0.0)],
-            walls,
-            margin: 0.0,
-            accepted_clearance: 0.0,
-            slack_weight: 100.0,
-            progress_dir: Vec2::new(1.0, 0.0),
-            sigma_range: &[(1.0, 1.0)],
-            c_range: &[(C_SCALE_UPS, C_SCALE_UPS)],
-            curvature: None,
-            wall_shift: None,
-            solver: SubProblemSolver::Riccati,
-        };
-        let layout = Layout::of(&sp);
+        let (sp, layout) = unit_chain(1, walls);
         let rhs = vec![0.5; walls.len()];
         solve(
             &StagedProblem::new(&sp, &layout, &rhs),
@@ -1079,8 +1067,8 @@ mod tests {
         )
     }
 
-    /// Three frames as [`one_frame`]'s, each with a wall of its own (rows on the frame's end position).
-    fn walled_chain() -> (SubProblem<'static>, Layout) {
+    /// `frames` frames as [`one_frame`]'s, at `x` = 5, 6, ..., with the wall rows `walls`.
+    fn unit_chain(frames: usize, walls: &[WallRow]) -> (SubProblem<'static>, Layout) {
         let mut a = [[0.0; 4]; 4];
         for (i, row) in a.iter_mut().enumerate() {
             row[i] = 1.0;
@@ -1089,27 +1077,32 @@ mod tests {
             a,
             b: [[0.0, 1.0 / C_SCALE_UPS], [1.0, 0.0], [0.0, 0.0], [0.0, 0.0]],
         };
-        let walls: &'static [WallRow] =
-            Box::leak(Box::new(std::array::from_fn::<_, 3, _>(|k| WallRow {
-                frame: k,
-                ..wall(k)
-            })));
+        let positions = (0..frames).map(|k| Vec2::new(5.0 + k as f64, 0.0));
         let sp = SubProblem {
-            jacobians: Box::leak(Box::new([jacobian; 3])),
-            positions: Box::leak(Box::new([5.0, 6.0, 7.0].map(|x| Vec2::new(x, 0.0)))),
-            walls,
+            jacobians: Box::leak(vec![jacobian; frames].into_boxed_slice()),
+            positions: Box::leak(positions.collect::<Vec<_>>().into_boxed_slice()),
+            walls: Box::leak(walls.to_vec().into_boxed_slice()),
             margin: 0.0,
             accepted_clearance: 0.0,
             slack_weight: 100.0,
             progress_dir: Vec2::new(1.0, 0.0),
-            sigma_range: &[(1.0, 1.0); 3],
-            c_range: &[(C_SCALE_UPS, C_SCALE_UPS); 3],
+            sigma_range: Box::leak(vec![(1.0, 1.0); frames].into_boxed_slice()),
+            c_range: Box::leak(vec![(C_SCALE_UPS, C_SCALE_UPS); frames].into_boxed_slice()),
             curvature: None,
             wall_shift: None,
             solver: SubProblemSolver::Riccati,
         };
         let layout = Layout::of(&sp);
         (sp, layout)
+    }
+
+    /// Three frames as [`one_frame`]'s, each with a wall of its own (rows on the frame's end position).
+    fn walled_chain() -> (SubProblem<'static>, Layout) {
+        let walls: [WallRow; 3] = std::array::from_fn(|k| WallRow {
+            frame: k,
+            ..wall(k)
+        });
+        unit_chain(3, &walls)
     }
 
     /// A wall keeping the end position at `y <= 0.5` (the row `-n . dp - s <= 0.5`, `n = (0, -1)`).
