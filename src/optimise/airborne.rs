@@ -26,7 +26,7 @@ use super::relaxed::{
 use super::scp::StageKind;
 use super::search::{FinePolish, Progress, SearchSettings};
 use super::verify::quantised_and_verified;
-use crate::sim::Trace;
+use crate::sim::{Crossing, Trace};
 
 /// Least gain of a round of the final polish, in frames, for another round to follow
 /// ([`best_plan_polished_on`]): a round over a few thousand frames costs seconds (docs/design.md, "The
@@ -41,6 +41,11 @@ const WIDENING_STEPS: usize = 4;
 /// ([`certificate_lines_rounded_while_ahead`]): a bound on the work, not tuned (the one scene known to
 /// take a second round stops after its third, its certificate no faster).
 const CERTIFICATE_LINE_ROUNDS: usize = 4;
+
+/// Most rounds of the certificate's fastest line refined at the final margin
+/// ([`certificate_line_rounded_at_the_final_margin`]), each while the plan is still behind it in a
+/// later frame: a bound on the work, not tuned.
+const FINAL_MARGIN_ROUNDS: usize = 3;
 
 /// Final wall margins tried, as multiples of the setting, until a plan stays valid.
 const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
@@ -210,6 +215,13 @@ pub(super) fn plan_airborne(
     if best_plan_polished_on(planner, greedy_s, &mut best) {
         polished_plan_as_certificate_start(planner, &mut certifier, terms, progress, &mut best);
     }
+    certificate_line_rounded_at_the_final_margin(
+        planner,
+        &mut certifier,
+        terms,
+        progress,
+        &mut best,
+    );
     AirbornePlan {
         best,
         certifier,
@@ -291,6 +303,83 @@ fn polished_plan_as_certificate_start(
     {
         certificate_lines_rounded_while_ahead(planner, certifier, line, terms, progress, best);
     }
+}
+
+/// Where the plan, polished, still crosses in a later frame than the certificate's fastest line, and is
+/// behind it by more than a replayable plan is estimated to lose against it ([`behind_beyond_estimates`]),
+/// that line refined at the final margin, the margin the plan itself keeps, then rounded, polished and
+/// verified; where that makes the plan faster, the plan is polished on and is the certificate's start
+/// again (with the rounds while a frame ahead), and the round is taken again, at most
+/// [`FINAL_MARGIN_ROUNDS`] times. Every other line is refined at the planning margin, `tau max(L,
+/// gamma1)` off the walls so that any rounding of its sides stays clear; where a line presses on the walls
+/// through braking turns, that width costs it a frame or two, which the polishes at the final margin do
+/// not win back (docs/design.md, "The certificate's line rounded at the final margin"). A plan rounded
+/// from the line at the final margin that scrapes a wall fails its replay, and the final margin widens
+/// as for every certificate's line.
+fn certificate_line_rounded_at_the_final_margin(
+    planner: &mut Planner,
+    certifier: &mut Certifier,
+    terms: PlanTerms,
+    progress: &mut dyn FnMut(Progress),
+    best: &mut BestPlan,
+) {
+    let final_margin = planner.settings.margin_units;
+    for _ in 0..FINAL_MARGIN_ROUNDS {
+        if planner.timed_out {
+            break;
+        }
+        let Some(line) = line_the_plan_is_behind(planner, certifier, best) else {
+            break;
+        };
+        let before_s = best.as_ref().map(|b| b.0);
+        let Some(source) = refined(
+            planner,
+            progress,
+            line,
+            terms.lo,
+            final_margin,
+            Widening::FinalMargin,
+        ) else {
+            break;
+        };
+        exact_plans(planner, &source, terms.greedy_s, best);
+        let gained = best
+            .as_ref()
+            .is_some_and(|b| before_s.is_none_or(|t| b.0 < t));
+        if !gained {
+            break;
+        }
+        best_plan_polished_on(planner, terms.greedy_s, best);
+        polished_plan_as_certificate_start(planner, certifier, terms, progress, best);
+    }
+}
+
+/// The certificate's fastest line, where the plan crosses in a later frame and behind it by more than
+/// the zigzag and guard estimates along it ([`behind_beyond_estimates`]).
+fn line_the_plan_is_behind(
+    planner: &Planner,
+    certifier: &Certifier,
+    best: &BestPlan,
+) -> Option<Vec<FrameControl>> {
+    let plan = best.as_ref().and_then(|(_, trace)| trace.crossing)?;
+    let line = certifier.best()?;
+    let estimates = certifier.certificate_with_estimates(&planner.start, &planner.fl)?;
+    let estimate_frames =
+        estimates.zigzag_frames.unwrap_or(0.0) + estimates.guard_frames.unwrap_or(0.0);
+    behind_beyond_estimates(line.crossing, plan, estimate_frames, planner.fl.tau_s)
+        .then(|| line.controls.clone())
+}
+
+/// Whether a plan crossing at `plan` is behind a certificate's line crossing at `certificate` by what a
+/// rounding could still win: it crosses in a later frame, and more than `estimate_frames` (what a
+/// replayable plan is estimated to lose against the line) of frame time `frame_s` after it.
+fn behind_beyond_estimates(
+    certificate: Crossing,
+    plan: Crossing,
+    estimate_frames: f64,
+    frame_s: f64,
+) -> bool {
+    certificate.frames < plan.frames && plan.time - certificate.time > estimate_frames * frame_s
 }
 
 /// What the exact plans of a certificate's line are held to: no plan crosses before frame `lo`, each
@@ -757,6 +846,47 @@ mod tests {
     use crate::optimise::search::SearchSettings;
     use crate::optimise::verify::time_of;
     use crate::optimise::Quality;
+
+    #[test]
+    fn a_plan_is_behind_a_certificate_line_only_in_a_later_frame_and_beyond_the_estimates() {
+        let frame = 0.01;
+        let at = |frames: u64, fraction: f64| Crossing::new(frames, fraction, frame);
+        // Half a frame behind, in the next frame, with estimates of a tenth: a rounding can win it.
+        assert!(behind_beyond_estimates(
+            at(408, 0.97),
+            at(409, 0.47),
+            0.1,
+            frame
+        ));
+        // The same gap explained by the estimates (the guard under the kink at 1000 fps): nothing to win.
+        assert!(!behind_beyond_estimates(
+            at(408, 0.97),
+            at(409, 0.47),
+            0.6,
+            frame
+        ));
+        // In the same frame, however far behind: the rounding target is met.
+        assert!(!behind_beyond_estimates(
+            at(408, 0.05),
+            at(408, 0.95),
+            0.0,
+            frame
+        ));
+        // Ahead of the line (a plan that slides along a wall the certificate keeps off).
+        assert!(!behind_beyond_estimates(
+            at(409, 0.2),
+            at(408, 0.9),
+            0.0,
+            frame
+        ));
+        // Across the frame's boundary by a hair beyond estimates of zero.
+        assert!(behind_beyond_estimates(
+            at(135, 0.99),
+            at(136, 0.01),
+            0.0,
+            frame
+        ));
+    }
 
     #[test]
     fn a_certificate_line_is_rounded_again_only_after_a_round_that_gained_and_a_frame_behind_it() {

@@ -485,7 +485,7 @@ pub fn guard_frames(start: &ModelState, controls: &[FrameControl], fl: &FrameLaw
 pub(super) struct CertifiedPlan {
     pub(super) controls: Vec<FrameControl>,
     pub(super) start_index: usize,
-    crossing: Crossing,
+    pub(super) crossing: Crossing,
 }
 
 /// The certificate as its starts are solved: what each start reached and the fastest plan.
