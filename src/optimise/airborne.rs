@@ -9,7 +9,10 @@
 //! 4. each line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
 //!    fastest valid exact plan is kept;
 //! 5. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]);
-//! 6. where the settings ask for it (`balanced` and `exact`), polished on again at smaller wall margins
+//! 6. where it still crosses in a later frame than the certificate's fastest line, by more than the
+//!    estimates say a replayable plan loses, that line refined at the final margin and rounded again
+//!    ([`certificate_line_rounded_at_the_final_margin`]);
+//! 7. where the settings ask for it (`balanced` and `exact`), polished on again at smaller wall margins
 //!    ([`plan_polished_finely`], run by [`super::search`] after the rest).
 //!
 //! Where the relaxed stage finds no line from the seed, the certificate's greedy starts' lines are the
@@ -767,7 +770,7 @@ fn best_plan_polished_on(planner: &mut Planner, greedy_s: f64, best: &mut BestPl
     improved
 }
 
-/// Stage 6 ([`FinePolish`], where the settings ask for it): the fastest valid plan polished on again at
+/// Stage 7 ([`FinePolish`], where the settings ask for it): the fastest valid plan polished on again at
 /// each of `fine`'s wall margins in turn, with its iterations and tolerance, in rounds as
 /// [`best_plan_polished_on`]: each plan quantised and verified, and kept only if faster. Where one is,
 /// the plan is a start of the certificate too once the last margin is done, as after stage 5 (no plan
