@@ -23,8 +23,8 @@ use super::model::{rollout, FrameControl};
 use super::planner::Planner;
 use super::polish::{polished_again, rounded_and_polished, MARGIN_RETRIES};
 use super::relaxed::{
-    count_search, relaxed_plan, Certifier, CountSearch, Descent, Relaxation, StartKind,
-    CERTIFICATE_MARGIN_UNITS,
+    count_search, guard_frames, relaxed_plan, zigzag_frames, Certifier, CountSearch, Descent,
+    Relaxation, StartKind, CERTIFICATE_MARGIN_UNITS,
 };
 use super::scp::StageKind;
 use super::search::{FinePolish, Progress, SearchSettings};
@@ -346,15 +346,18 @@ fn certificate_line_rounded_at_the_final_margin(
             break;
         };
         exact_plans(planner, &source, terms.greedy_s, best);
-        let gained = best
-            .as_ref()
-            .is_some_and(|b| before_s.is_none_or(|t| b.0 < t));
-        if !gained {
+        if !faster_than_before(best, before_s) {
             break;
         }
         best_plan_polished_on(planner, terms.greedy_s, best);
         polished_plan_as_certificate_start(planner, certifier, terms, progress, best);
     }
+}
+
+/// Whether `best` holds a plan faster than `before_s` (seconds; `None`: there was no plan).
+fn faster_than_before(best: &BestPlan, before_s: Option<f64>) -> bool {
+    best.as_ref()
+        .is_some_and(|b| before_s.is_none_or(|t| b.0 < t))
 }
 
 /// The certificate's fastest line, where the plan crosses in a later frame and behind it by more than
@@ -366,23 +369,24 @@ fn line_the_plan_is_behind(
 ) -> Option<Vec<FrameControl>> {
     let plan = best.as_ref().and_then(|(_, trace)| trace.crossing)?;
     let line = certifier.best()?;
-    let estimates = certifier.certificate_with_estimates(&planner.start, &planner.fl)?;
+    let (start, fl) = (&planner.start, &planner.fl);
     let estimate_frames =
-        estimates.zigzag_frames.unwrap_or(0.0) + estimates.guard_frames.unwrap_or(0.0);
-    behind_beyond_estimates(line.crossing, plan, estimate_frames, planner.fl.tau_s)
+        || zigzag_frames(start, &line.controls, fl) + guard_frames(start, &line.controls, fl);
+    behind_beyond_estimates(line.crossing, plan, fl.tau_s, estimate_frames)
         .then(|| line.controls.clone())
 }
 
 /// Whether a plan crossing at `plan` is behind a certificate's line crossing at `certificate` by what a
-/// rounding could still win: it crosses in a later frame, and more than `estimate_frames` (what a
-/// replayable plan is estimated to lose against the line) of frame time `frame_s` after it.
+/// rounding could still win: it crosses in a later frame, and more than `estimate_frames()` (what a
+/// replayable plan is estimated to lose against the line, two rollouts: asked for only once the frames
+/// differ) of frame time `frame_s` after it.
 fn behind_beyond_estimates(
     certificate: Crossing,
     plan: Crossing,
-    estimate_frames: f64,
     frame_s: f64,
+    estimate_frames: impl FnOnce() -> f64,
 ) -> bool {
-    certificate.frames < plan.frames && plan.time - certificate.time > estimate_frames * frame_s
+    certificate.frames < plan.frames && plan.time - certificate.time > estimate_frames() * frame_s
 }
 
 /// What the exact plans of a certificate's line are held to: no plan crosses before frame `lo`, each
@@ -427,10 +431,7 @@ fn another_line_beside_the_plan_as_start(
             faster_line = certifier.best().map(|p| p.controls.clone());
         }
     }
-    let improved = best
-        .as_ref()
-        .is_some_and(|b| plan_so_far_s.is_none_or(|t| b.0 < t));
-    if improved {
+    if faster_than_before(best, plan_so_far_s) {
         if let Some(l) = plan_as_certificate_start(planner, certifier, best, lo, progress) {
             faster_line = Some(l);
         }
@@ -858,36 +859,36 @@ mod tests {
         assert!(behind_beyond_estimates(
             at(408, 0.97),
             at(409, 0.47),
-            0.1,
-            frame
+            frame,
+            || 0.1
         ));
         // The same gap explained by the estimates (the guard under the kink at 1000 fps): nothing to win.
         assert!(!behind_beyond_estimates(
             at(408, 0.97),
             at(409, 0.47),
-            0.6,
-            frame
+            frame,
+            || 0.6
         ));
         // In the same frame, however far behind: the rounding target is met.
         assert!(!behind_beyond_estimates(
             at(408, 0.05),
             at(408, 0.95),
-            0.0,
-            frame
+            frame,
+            || 0.0
         ));
         // Ahead of the line (a plan that slides along a wall the certificate keeps off).
         assert!(!behind_beyond_estimates(
             at(409, 0.2),
             at(408, 0.9),
-            0.0,
-            frame
+            frame,
+            || 0.0
         ));
         // Across the frame's boundary by a hair beyond estimates of zero.
         assert!(behind_beyond_estimates(
             at(135, 0.99),
             at(136, 0.01),
-            0.0,
-            frame
+            frame,
+            || 0.0
         ));
     }
 
