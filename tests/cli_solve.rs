@@ -107,6 +107,30 @@ fn json_carries_every_documented_key() {
     );
     assert!(lb <= t && t < g, "{lb} <= {t} < {g}");
     assert!(v["frames"].as_u64().unwrap_or(0) < v["greedy"]["frames"].as_u64().unwrap_or(0));
+    // Where the time went, stage by stage: within the solve's time.
+    let stages = [
+        "bound",
+        "baseline",
+        "relaxed_line",
+        "first_plans",
+        "certificate_wait",
+        "certificate_lines",
+        "polish_on",
+        "final_margin_round",
+        "fine_polish",
+        "jumps",
+        "verification",
+    ];
+    let staged: f64 = stages
+        .iter()
+        .map(|k| {
+            v["stage_seconds"][k]
+                .as_f64()
+                .unwrap_or_else(|| panic!("missing stage_seconds.{k}"))
+        })
+        .sum();
+    let solve_s = v["solve_seconds"].as_f64().unwrap_or(f64::NAN);
+    assert!(staged > 0.0 && staged <= solve_s, "{staged} of {solve_s} s");
 }
 
 #[test]

@@ -659,8 +659,15 @@ fn bench_generated_gives_a_record_per_scene_and_the_distributions() {
         "frames gained on greedy",
         "gap to bound (%)",
         "solve time per frame (ms)",
+        "share in the relaxed line (%)",
     ] {
         assert!(columns.contains(&c), "{columns:?}");
+    }
+    // Where each solve's time went: the relaxed line ran on both, within the solve.
+    for r in &scenes {
+        let relaxed_line = r["stage_seconds"]["relaxed_line"].as_f64().unwrap_or(0.0);
+        let solve_s = r["solve_seconds"].as_f64().unwrap_or(0.0);
+        assert!(relaxed_line > 0.0 && relaxed_line < solve_s, "{r}");
     }
     // Where each plan crosses against its relaxed optimum's frame, counted, and how much of that frame
     // the relaxed optimum leaves, per record (a fraction of a frame).

@@ -222,6 +222,43 @@ fn each_level_polishes_the_plan_below_on_to_a_sooner_crossing() {
 }
 
 #[test]
+fn the_stages_clock_the_solve_each_its_own_part() {
+    // Generated scene 5 of seed 12 (CI-sized, 99 frames at 100 fps), and a bunnyhop bend. The stages run
+    // one after another on the solving thread and add up to the solve, less the moments between them; a
+    // stage that does not run is never clocked.
+    let airborne = generate(12, 5, &GeneratorSettings::ci_sized())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .scene;
+    let jumping = load("hl-bhop-bend90-100fps");
+    for (scene, quality) in [
+        (&airborne, Quality::Fast),
+        (&airborne, Quality::Balanced),
+        (&jumping, Quality::Fast),
+    ] {
+        let (o, _) = solved(scene, quality);
+        let s = o.stage_seconds;
+        let named = s.named();
+        assert!(named.iter().all(|(_, t)| *t >= 0.0), "{named:?}");
+        assert!(
+            s.total() <= o.solve_seconds + 1e-9 && s.total() >= 0.8 * o.solve_seconds,
+            "{named:?} against the solve's {} s",
+            o.solve_seconds
+        );
+        assert!(s.baseline > 0.0, "{named:?}");
+        let ran_airborne = [s.relaxed_line, s.first_plans, s.verification];
+        if scene.effects.is_air_only() {
+            assert!(ran_airborne.iter().all(|t| *t > 0.0), "{named:?}");
+            assert_eq!(s.jumps, 0.0, "{named:?}");
+            // Only the levels above `fast` polish at smaller margins.
+            assert_eq!(s.fine_polish > 0.0, quality != Quality::Fast, "{named:?}");
+        } else {
+            assert!(s.jumps > 0.0, "{named:?}");
+            assert!(ran_airborne.iter().all(|t| *t == 0.0), "{named:?}");
+        }
+    }
+}
+
+#[test]
 fn solving_twice_gives_the_same_plan() {
     let scene = load("hl-bend90-100fps");
     let s = SearchSettings::for_quality(Quality::Fast);

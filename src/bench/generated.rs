@@ -5,7 +5,7 @@
 //! Wall times are measured around each solve with [`Instant`]: measurements, not targets.
 
 use crate::geometry::BoundaryKind;
-use crate::optimise::{solve, SearchSettings};
+use crate::optimise::{solve, SearchSettings, StageSeconds};
 use crate::scene::generate::{GeneratedScene, SceneKind};
 use serde::Serialize;
 use std::time::Instant;
@@ -53,6 +53,8 @@ pub struct SceneRecord {
     pub solve_seconds: f64,
     /// Solve wall time per frame of the plan, milliseconds.
     pub solve_ms_per_frame: Option<f64>,
+    /// Where the solve's time went, seconds per stage (`solve`'s `stage_seconds`).
+    pub stage_seconds: Option<StageSeconds>,
     /// The relaxed certificate's crossing frame and time, seconds.
     pub relaxed_frames: Option<u64>,
     /// The relaxed certificate's crossing time, game seconds.
@@ -105,6 +107,7 @@ impl SceneRecord {
             gap_pct: None,
             solve_seconds: 0.0,
             solve_ms_per_frame: None,
+            stage_seconds: None,
             relaxed_frames: None,
             relaxed_time_s: None,
             relaxed_spread_s: None,
@@ -118,6 +121,15 @@ impl SceneRecord {
             greedy_guide: String::new(),
             status: String::new(),
         }
+    }
+}
+
+impl SceneRecord {
+    /// The share of the solve's time that `stage` took, percent, on an airborne scene (a scene with
+    /// jumps or ground frames runs other stages).
+    fn stage_share(&self, stage: fn(&StageSeconds) -> f64) -> Option<f64> {
+        let seconds = self.stage_seconds.filter(|_| self.kind == SceneKind::Air)?;
+        (self.solve_seconds > 0.0).then(|| 100.0 * stage(&seconds) / self.solve_seconds)
     }
 }
 
@@ -159,6 +171,7 @@ pub fn measure_generated_scene(g: &GeneratedScene, settings: &SearchSettings) ->
         .frames
         .filter(|&f| f > 0)
         .map(|f| 1000.0 * r.solve_seconds / f as f64);
+    r.stage_seconds = Some(out.stage_seconds);
     r.replays = out.stats.replays;
     r.valid_replays = out.stats.valid_replays;
     r.greedy_guide = out.greedy_guide.to_string();
@@ -247,6 +260,38 @@ pub fn columns() -> Vec<Column> {
         Column {
             name: "solve time (s)",
             value: |r| Some(r.solve_seconds),
+        },
+        Column {
+            name: "share in the baseline (%)",
+            value: |r| r.stage_share(|s| s.baseline),
+        },
+        Column {
+            name: "share in the relaxed line (%)",
+            value: |r| r.stage_share(|s| s.relaxed_line),
+        },
+        Column {
+            name: "share in the first plans (%)",
+            value: |r| r.stage_share(|s| s.first_plans),
+        },
+        Column {
+            name: "share waiting for the certificate (%)",
+            value: |r| r.stage_share(|s| s.certificate_wait),
+        },
+        Column {
+            name: "share in the certificate's lines (%)",
+            value: |r| r.stage_share(|s| s.certificate_lines),
+        },
+        Column {
+            name: "share in the polish on (%)",
+            value: |r| r.stage_share(|s| s.polish_on),
+        },
+        Column {
+            name: "share in the final-margin round (%)",
+            value: |r| r.stage_share(|s| s.final_margin_round),
+        },
+        Column {
+            name: "share in the fine polish (%)",
+            value: |r| r.stage_share(|s| s.fine_polish),
         },
     ]
 }
@@ -368,6 +413,7 @@ mod tests {
             gap_pct: Some(1.0),
             solve_seconds: seconds,
             solve_ms_per_frame: Some(10.0 * seconds),
+            stage_seconds: None,
             relaxed_frames: None,
             relaxed_time_s: None,
             relaxed_spread_s: None,
@@ -381,6 +427,31 @@ mod tests {
             greedy_guide: String::new(),
             status: String::new(),
         }
+    }
+
+    #[test]
+    fn a_stages_share_is_of_the_solve_and_only_on_airborne_scenes() {
+        let seconds = StageSeconds {
+            relaxed_line: 1.0,
+            first_plans: 0.5,
+            ..StageSeconds::default()
+        };
+        let airborne = SceneRecord {
+            stage_seconds: Some(seconds),
+            ..record(None, 4.0)
+        };
+        let shares = |r: &SceneRecord| {
+            let stages: [fn(&StageSeconds) -> f64; 2] = [|s| s.relaxed_line, |s| s.first_plans];
+            stages.map(|f| r.stage_share(f))
+        };
+        assert_eq!(shares(&airborne), [Some(25.0), Some(12.5)]);
+        // A bunnyhop's stages are others; a record without its stages (a failed solve) has none.
+        let jumping = SceneRecord {
+            kind: SceneKind::Bhop,
+            ..airborne.clone()
+        };
+        assert_eq!(shares(&jumping), [None, None]);
+        assert_eq!(shares(&record(None, 4.0)), [None, None]);
     }
 
     #[test]

@@ -5,7 +5,9 @@ use super::{progress, write_artifacts_within};
 use crate::budget::{Budget, Stage};
 use crate::error::{Error, Result};
 use crate::optimise::search::{self, time_limit, Progress};
-use crate::optimise::{Outcome, Quality, SearchSettings, SearchStatus, CERTIFIED_CLEARANCE_UNITS};
+use crate::optimise::{
+    Outcome, Quality, SearchSettings, SearchStatus, StageSeconds, CERTIFIED_CLEARANCE_UNITS,
+};
 use crate::scene::Scene;
 use serde_json::{json, Value};
 
@@ -150,6 +152,7 @@ pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
         "gap_to_lower_bound": crossing.map(|c| (c.time - lb.time) / lb.time.max(f64::MIN_POSITIVE)),
         "status": o.status,
         "stats": o.stats,
+        "stage_seconds": o.stage_seconds,
         "solve_seconds": o.solve_seconds,
     })
 }
@@ -352,7 +355,19 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
             o.solve_seconds, o.stats.iterations
         ),
     ));
+    s.push_str(&field("by stage", stage_seconds_text(&o.stage_seconds)));
     s
+}
+
+/// The stages that took any time, each with its seconds, in the order they ran.
+fn stage_seconds_text(seconds: &StageSeconds) -> String {
+    let stages: Vec<String> = seconds
+        .named()
+        .iter()
+        .filter(|(_, s)| *s >= 0.005)
+        .map(|(name, s)| format!("{name} {s:.2} s"))
+        .collect();
+    stages.join(", ")
 }
 
 #[cfg(test)]

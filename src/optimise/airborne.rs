@@ -27,9 +27,10 @@ use super::relaxed::{
     Relaxation, StartKind, CERTIFICATE_MARGIN_UNITS,
 };
 use super::scp::StageKind;
-use super::search::{FinePolish, Progress, SearchSettings};
+use super::search::{seconds_since, FinePolish, Progress, SearchSettings};
 use super::verify::quantised_and_verified;
 use crate::sim::{Crossing, Trace};
+use std::time::Instant;
 
 /// Least gain of a round of the final polish, in frames, for another round to follow
 /// ([`best_plan_polished_on`]): a round over a few thousand frames costs seconds (docs/design.md, "The
@@ -125,6 +126,7 @@ pub(super) struct AirbornePlan {
 
 /// Stages 2 to 4 (see the module documentation): `warm` is the seed in planning controls, crossing near
 /// frame `n`; no plan crosses before frame `lo`; a plan is kept only if it is faster than `greedy_s`.
+/// Each stage's seconds go to `planner.seconds`.
 pub(super) fn plan_airborne(
     planner: &mut Planner,
     base: &Baseline,
@@ -135,12 +137,21 @@ pub(super) fn plan_airborne(
     progress: &mut dyn FnMut(Progress),
 ) -> AirbornePlan {
     let margins = LineMargins::of(planner);
+    let first_started = Instant::now();
     let greedy_starts = certificate_greedy_starts(planner, base);
     let planning = Relaxation::planning(margins.planning);
     let side = move |fork: &mut Planner| certified_greedy_starts(fork, greedy_starts, planning, lo);
+    let mut plans_done = None;
     let (mine, side_certifiers) = planner.beside_forks(vec![side], |planner| {
-        lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress)
+        let mine = lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress);
+        plans_done = Some(Instant::now());
+        mine
     });
+    planner.seconds.certificate_wait += plans_done.map_or(0.0, seconds_since);
+    // The relaxed line and the waits are clocked on their own, inside.
+    planner.seconds.first_plans = seconds_since(first_started)
+        - planner.seconds.relaxed_line
+        - planner.seconds.certificate_wait;
     // Where the relaxed stage found no line from the seed, a line the certificate's greedy starts reached
     // is the one to round (the certificate's fastest, as another optimum crossing before any frame).
     let relaxed_found = mine.is_some();
@@ -156,6 +167,55 @@ pub(super) fn plan_airborne(
             relaxed_found,
         };
     }
+    let terms = PlanTerms {
+        lo,
+        margins,
+        greedy_s,
+    };
+    let lines_started = Instant::now();
+    certificate_lines_rounded(
+        planner,
+        &mut certifier,
+        relaxed_line_frame,
+        terms,
+        progress,
+        &mut best,
+    );
+    planner.seconds.certificate_lines = seconds_since(lines_started);
+    let polish_started = Instant::now();
+    plan_polished_on(planner, &mut certifier, terms, progress, &mut best);
+    planner.seconds.polish_on = seconds_since(polish_started);
+    let round_started = Instant::now();
+    certificate_line_rounded_at_the_final_margin(
+        planner,
+        &mut certifier,
+        terms,
+        progress,
+        &mut best,
+    );
+    planner.seconds.final_margin_round = seconds_since(round_started);
+    AirbornePlan {
+        best,
+        certifier,
+        relaxed_found: true,
+    }
+}
+
+/// The lines of the certificate's problem rounded too: another optimum than the relaxed stage's (a
+/// greedy start's, faster by more than the stages can tell apart, or any start's crossing a frame or
+/// more before the fastest plan, or the relaxed line where there is no plan), and the fastest greedy
+/// start's line of the plan's frame (the rounding's outcome within a frame depends on its line:
+/// [`Certifier::fastest_greedy_line`]). One is rounded beside the plan as a start: another optimum's
+/// where there is one, the greedy start's line first. `relaxed_line_frame` is the frame the relaxed line
+/// crosses in, the frame to beat where there is no plan.
+fn certificate_lines_rounded(
+    planner: &mut Planner,
+    certifier: &mut Certifier,
+    relaxed_line_frame: u64,
+    terms: PlanTerms,
+    progress: &mut dyn FnMut(Progress),
+    best: &mut BestPlan,
+) {
     let same_optimum_s = certifier
         .best()
         .map_or(0.0, |p| same_optimum_s(planner, &p.controls));
@@ -163,17 +223,6 @@ pub(super) fn plan_airborne(
         .as_ref()
         .and_then(|(_, trace)| trace.crossing.map(|c| c.frames))
         .unwrap_or(relaxed_line_frame);
-    let terms = PlanTerms {
-        lo,
-        margins,
-        greedy_s,
-    };
-    // The lines of the certificate's problem rounded too: another optimum than the relaxed stage's (a
-    // greedy start's, faster by more than the stages can tell apart, or any start's crossing a frame or
-    // more before the fastest plan, or the relaxed line where there is no plan), and the fastest greedy
-    // start's line of the plan's frame (the rounding's outcome within a frame depends on its line:
-    // [`Certifier::fastest_greedy_line`]). One is rounded beside the plan as a start: another optimum's
-    // where there is one, the greedy start's line first.
     let another = certifier
         .another_optimum(same_optimum_s, frame_to_beat)
         .map(|p| (p.start_index, p.controls.clone()));
@@ -185,50 +234,39 @@ pub(super) fn plan_airborne(
         None => (greedy_line, None),
     };
     if let Some(line) = first {
-        plans_of_certificate_line(planner, line, terms, progress, &mut best);
+        plans_of_certificate_line(planner, line, terms, progress, best);
     }
     // Descending from the plan, the certificate's problem can find a faster line than the relaxed stage
     // did (it stopped short of its optimum, or in a slower basin): that line is rounded too, and the plan
     // that comes of it is a start again, so that the certificate stays no slower than the plan; a faster
     // line from that start is rounded in turn while the plan gains and is a frame or more behind it.
     let faster_line = match beside {
-        Some(line) => another_line_beside_the_plan_as_start(
-            planner,
-            &mut certifier,
-            line,
-            terms,
-            progress,
-            &mut best,
-        ),
-        None => plan_as_certificate_start(planner, &mut certifier, &best, lo, progress),
+        Some(line) => {
+            another_line_beside_the_plan_as_start(planner, certifier, line, terms, progress, best)
+        }
+        None => plan_as_certificate_start(planner, certifier, best, terms.lo, progress),
     };
     if let Some(line) = faster_line {
-        certificate_lines_rounded_while_ahead(
-            planner,
-            &mut certifier,
-            line,
-            terms,
-            progress,
-            &mut best,
-        );
+        certificate_lines_rounded_while_ahead(planner, certifier, line, terms, progress, best);
     }
-    if failed_plan_polished_wider(planner, greedy_s, &mut best) {
-        polished_plan_as_certificate_start(planner, &mut certifier, terms, progress, &mut best);
+}
+
+/// The plan polished on: a plan whose replay failed polished wider ([`failed_plan_polished_wider`]), then
+/// the fastest plan from its own controls ([`best_plan_polished_on`]); each that made the plan faster
+/// starts the certificate again ([`polished_plan_as_certificate_start`]).
+fn plan_polished_on(
+    planner: &mut Planner,
+    certifier: &mut Certifier,
+    terms: PlanTerms,
+    progress: &mut dyn FnMut(Progress),
+    best: &mut BestPlan,
+) {
+    let greedy_s = terms.greedy_s;
+    if failed_plan_polished_wider(planner, greedy_s, best) {
+        polished_plan_as_certificate_start(planner, certifier, terms, progress, best);
     }
-    if best_plan_polished_on(planner, greedy_s, &mut best) {
-        polished_plan_as_certificate_start(planner, &mut certifier, terms, progress, &mut best);
-    }
-    certificate_line_rounded_at_the_final_margin(
-        planner,
-        &mut certifier,
-        terms,
-        progress,
-        &mut best,
-    );
-    AirbornePlan {
-        best,
-        certifier,
-        relaxed_found: true,
+    if best_plan_polished_on(planner, greedy_s, best) {
+        polished_plan_as_certificate_start(planner, certifier, terms, progress, best);
     }
 }
 
@@ -605,6 +643,7 @@ fn lines_and_plans(
     greedy_s: f64,
     progress: &mut dyn FnMut(Progress),
 ) -> Option<(Certifier, BestPlan, u64)> {
+    let relaxed_started = Instant::now();
     let relaxed = relaxed_plan(
         planner,
         progress,
@@ -614,7 +653,9 @@ fn lines_and_plans(
         Relaxation::planning(margins.planning),
         Descent::PLAN,
     )
-    .line?;
+    .line;
+    planner.seconds.relaxed_line = seconds_since(relaxed_started);
+    let relaxed = relaxed?;
     let relaxed_line_frame = planner.crossing_of(&relaxed).map_or(u64::MAX, |c| c.frames);
     let start = relaxed.clone();
     let certify = move |fork: &mut Planner| {
@@ -622,9 +663,13 @@ fn lines_and_plans(
         certifier.add_start(fork, &mut |_| {}, start, StartKind::Planned, lo);
         certifier
     };
+    let mut plans_done = None;
     let (best, certifiers) = planner.beside_forks(vec![certify], |planner| {
-        exact_plans_of_both_lines(planner, relaxed, lo, margins, greedy_s, progress)
+        let best = exact_plans_of_both_lines(planner, relaxed, lo, margins, greedy_s, progress);
+        plans_done = Some(Instant::now());
+        best
     });
+    planner.seconds.certificate_wait += plans_done.map_or(0.0, seconds_since);
     let certifier = certifiers.into_iter().next().unwrap_or_default();
     Some((certifier, best, relaxed_line_frame))
 }

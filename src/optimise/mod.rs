@@ -28,5 +28,5 @@ pub use policy_run::PolicyRun;
 pub use relaxed::{RelaxedCertificate, CERTIFIED_CLEARANCE_UNITS};
 pub use search::{
     solve, solve_cancellable, solve_with_progress, FinePolish, Outcome, Progress, Quality,
-    SearchSettings, SearchStatus,
+    SearchSettings, SearchStatus, StageSeconds,
 };

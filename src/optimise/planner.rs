@@ -3,7 +3,7 @@
 
 use super::model::{frame_control_of, rollout, FrameControl, FrameLaw, ModelState};
 use super::scp::{run_scp, ScpProblem, StageKind};
-use super::search::{SearchSettings, SearchStats};
+use super::search::{SearchSettings, SearchStats, StageSeconds};
 use super::LowerBound;
 use crate::budget::{Budget, Stage};
 use crate::physics::{Control, Vec2};
@@ -37,6 +37,9 @@ pub(super) struct Planner<'a> {
     /// crosses in the model, and its controls (a fork's own is not joined back: exact plans are verified on
     /// the solve's planner).
     pub(super) earliest_failed_plan: Option<(Crossing, Vec<FrameControl>)>,
+    /// The seconds of the airborne stages run on this planner's thread (a fork's are not joined back:
+    /// its work is inside the stage it runs beside).
+    pub(super) seconds: StageSeconds,
 }
 
 /// The airborne frame law of a scene.
@@ -86,6 +89,7 @@ impl<'a> Planner<'a> {
             timed_out: false,
             cut_in: None,
             earliest_failed_plan: None,
+            seconds: StageSeconds::default(),
         }
     }
 
@@ -105,6 +109,7 @@ impl<'a> Planner<'a> {
             timed_out: false,
             cut_in: None,
             earliest_failed_plan: None,
+            seconds: StageSeconds::default(),
         }
     }
 

@@ -273,6 +273,70 @@ impl SearchStats {
     }
 }
 
+/// Where a solve's time went: the wall-clock seconds of each of its stages on the solving thread, in the
+/// order they run. Work on other threads is inside the stage it runs beside (the certificate's greedy
+/// starts beside the relaxed line and the first plans, its start from the relaxed line beside the first
+/// plans), so the stages add up to the solve, less the moments between them. A stage that does not run
+/// takes 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct StageSeconds {
+    /// The lower bound (the shortest path and its speed profile, or the jump schedules).
+    pub bound: f64,
+    /// The greedy baseline over its guides, and the seed.
+    pub baseline: f64,
+    /// The relaxed line from the seed: its count search, coarse to fine.
+    pub relaxed_line: f64,
+    /// The relaxed and tight lines rounded, polished and verified.
+    pub first_plans: f64,
+    /// The first plans done, the wait for the certificate's starts still running on other threads (its
+    /// greedy starts, and its start from the relaxed line).
+    pub certificate_wait: f64,
+    /// The certificate's lines rounded: a greedy start's line of the plan's frame, another optimum, and the
+    /// faster lines the certificate finds from the plan.
+    pub certificate_lines: f64,
+    /// The plan polished on from its own controls, a failed plan polished wider, and the certificate
+    /// started from the polished plan.
+    pub polish_on: f64,
+    /// The certificate's fastest line refined and rounded at the final margin where the plan is still a
+    /// frame behind it.
+    pub final_margin_round: f64,
+    /// The polishes at smaller wall margins of `balanced` and `exact`.
+    pub fine_polish: f64,
+    /// The policy search of a scene with jumps or ground frames, its plan's verification included.
+    pub jumps: f64,
+    /// The plan replayed in the engine-exact mode, and the certificate's estimates.
+    pub verification: f64,
+}
+
+impl StageSeconds {
+    /// Each stage's name, as the text output prints it, and its seconds, in the order the stages run.
+    pub fn named(&self) -> [(&'static str, f64); 11] {
+        [
+            ("bound", self.bound),
+            ("baseline", self.baseline),
+            ("relaxed line", self.relaxed_line),
+            ("first plans", self.first_plans),
+            ("certificate wait", self.certificate_wait),
+            ("certificate lines", self.certificate_lines),
+            ("polish on", self.polish_on),
+            ("final-margin round", self.final_margin_round),
+            ("fine polish", self.fine_polish),
+            ("jumps", self.jumps),
+            ("verification", self.verification),
+        ]
+    }
+
+    /// The stages' sum, seconds.
+    pub fn total(&self) -> f64 {
+        self.named().iter().map(|(_, s)| s).sum()
+    }
+}
+
+/// The seconds since `started`.
+pub(super) fn seconds_since(started: Instant) -> f64 {
+    started.elapsed().as_secs_f64()
+}
+
 /// The result of `solve`.
 #[derive(Clone, Debug)]
 pub struct Outcome {
@@ -298,6 +362,8 @@ pub struct Outcome {
     pub greedy_guide: GreedyGuide,
     /// The relaxed optimum the plan is measured against, on airborne scenes.
     pub relaxed: Option<RelaxedCertificate>,
+    /// Where the solve's time went.
+    pub stage_seconds: StageSeconds,
 }
 
 /// What the search is doing, for a progress display (the library prints nothing itself).
@@ -445,6 +511,7 @@ impl Finisher<'_> {
             source,
             greedy_guide: self.greedy.guide,
             relaxed: None,
+            stage_seconds: StageSeconds::default(),
         }
     }
 
@@ -475,7 +542,10 @@ fn solve_within(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Outcome> {
     let started = Instant::now();
+    let mut seconds = StageSeconds::default();
     let bound = lower_bound_within(scene, &scene.corridor()?, &budget)?;
+    seconds.bound = seconds_since(started);
+    let baseline_started = Instant::now();
     let scene = &frame_limited_scene(scene, &bound, settings.max_frames)?;
     let sim = Simulation::new(scene)?;
     if budget.expired() {
@@ -483,6 +553,7 @@ fn solve_within(
     }
     // Stage 1: seed and baseline.
     let base = baseline(&sim, scene, &bound, &budget);
+    seconds.baseline = seconds_since(baseline_started);
     let greedy = &base.greedy.trace;
     let seed = base.seed();
     if budget.expired() && !greedy.feasible() {
@@ -499,7 +570,13 @@ fn solve_within(
         started,
     };
     if !scene.effects.is_air_only() {
-        return Ok(plan_jumping_scene(&finisher, settings, budget));
+        let jumps_from_s = seconds_since(started);
+        let outcome = plan_jumping_scene(&finisher, settings, budget);
+        seconds.jumps = outcome.solve_seconds - jumps_from_s;
+        return Ok(Outcome {
+            stage_seconds: seconds,
+            ..outcome
+        });
     }
     let mut planner = Planner::new(scene, &sim, settings, &bound, seed, budget);
     let warm = planner.warm_start(seed);
@@ -520,8 +597,15 @@ fn solve_within(
     let greedy_s = time_of(greedy);
     let mut found = plan_airborne(&mut planner, &base, warm, n, lo, greedy_s, progress);
     if let Some(fine) = settings.fine_polish {
+        let fine_started = Instant::now();
         plan_polished_finely(&mut planner, &mut found, fine, greedy_s, lo, progress);
+        planner.seconds.fine_polish = seconds_since(fine_started);
     }
+    // The verification ends where the outcome takes the solve's time: the stages add up to it.
+    let verification_from_s = seconds_since(started);
+    let relaxed = found
+        .certifier
+        .certificate_with_estimates(&planner.start, &planner.fl);
     let stats = planner.stats;
     let stopped = planner
         .cut_in
@@ -548,10 +632,15 @@ fn solve_within(
             )
         }
     };
+    let stage_seconds = StageSeconds {
+        bound: seconds.bound,
+        baseline: seconds.baseline,
+        verification: outcome.solve_seconds - verification_from_s,
+        ..planner.seconds
+    };
     Ok(Outcome {
-        relaxed: found
-            .certifier
-            .certificate_with_estimates(&planner.start, &planner.fl),
+        relaxed,
+        stage_seconds,
         ..outcome
     })
 }
