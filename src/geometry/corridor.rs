@@ -130,9 +130,13 @@ impl Corridor {
     /// convex and the move linear.
     pub fn rule_violation_swept(&self, p0: Vec2, p1: Vec2) -> bool {
         let d = p1 - p0;
+        let (lo, hi) = (
+            Vec2::new(p0.x.min(p1.x), p0.y.min(p1.y)),
+            Vec2::new(p0.x.max(p1.x), p0.y.max(p1.y)),
+        );
         self.pieces
             .iter()
-            .filter(|p| p.kind == BoundaryKind::Rule)
+            .filter(|p| p.kind == BoundaryKind::Rule && p.grown.box_near(lo, hi))
             .any(|p| {
                 p.grown
                     .open_interval(p0, d, CONTACT_TOL_UNITS)

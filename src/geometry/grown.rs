@@ -25,6 +25,10 @@ pub(crate) struct Plane {
     pub offset: f64,
 }
 
+/// How far, units, beyond a grown segment's bounding box [`GrownSegment::box_near`] still counts a box as
+/// near: far more than rounding in the planes' sides could reach at corridor coordinates.
+const BOX_NEAR_UNITS: f64 = 1.0;
+
 /// A segment grown by an axis-aligned box of half-width `half_width_units`.
 #[derive(Clone, Debug)]
 pub(crate) struct GrownSegment {
@@ -142,6 +146,19 @@ impl GrownSegment {
         from_corners.min(from_ends)
     }
 
+    /// Whether the box from `lo` to `hi` comes within [`BOX_NEAR_UNITS`] of this grown segment's bounding
+    /// box. A move whose box does not cannot enter the segment: the test skips its planes, and keeps far
+    /// enough off that rounding in them could not have told otherwise.
+    #[inline]
+    pub fn box_near(&self, lo: Vec2, hi: Vec2) -> bool {
+        let half = self.hull.half_extents;
+        let (reach_x, reach_y) = (half.x + BOX_NEAR_UNITS, half.y + BOX_NEAR_UNITS);
+        self.a.x.max(self.b.x) + reach_x >= lo.x
+            && self.a.x.min(self.b.x) - reach_x <= hi.x
+            && self.a.y.max(self.b.y) + reach_y >= lo.y
+            && self.a.y.min(self.b.y) - reach_y <= hi.y
+    }
+
     /// Times at which `p + t d` is strictly inside this grown segment shrunk by `shrink_units` (a negative
     /// value grows it), or `None` when it never is.
     pub fn open_interval(&self, p: Vec2, d: Vec2, shrink_units: f64) -> Option<Interval> {
@@ -235,6 +252,57 @@ mod tests {
         assert_eq!(g.vertices().len(), 6);
         let r = GrownSegment::new(Vec2::new(0.0, 0.0), Vec2::new(100.0, 0.0), 16.0);
         assert_eq!(r.vertices().len(), 4);
+    }
+
+    #[test]
+    fn a_move_whose_box_is_not_near_never_enters_the_segment() {
+        // Segments of every direction and moves of every length about them, from a fixed seed: wherever
+        // the boxes are far apart, the planes say the move never enters either, so skipping them changes
+        // no verdict; some moves are culled and some enter, so both branches are met.
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut culled, mut entered) = (0, 0);
+        for _ in 0..20_000 {
+            let mut point =
+                |spread: f64| Vec2::new(spread * (next() - 0.5), spread * (next() - 0.5));
+            let (a, b) = (point(400.0), point(400.0));
+            let g = GrownSegment::new(a, b, 16.0);
+            let p0 = point(600.0);
+            let p1 = p0 + point(300.0);
+            let enters = g
+                .open_interval(p0, p1 - p0, 0.0)
+                .is_some_and(|iv| iv.meets_unit_open());
+            let lo = Vec2::new(p0.x.min(p1.x), p0.y.min(p1.y));
+            let hi = Vec2::new(p0.x.max(p1.x), p0.y.max(p1.y));
+            if !g.box_near(lo, hi) {
+                culled += 1;
+                assert!(!enters, "{a:?}-{b:?}: {p0:?} -> {p1:?}");
+            }
+            entered += usize::from(enters);
+        }
+        assert!(
+            culled > 1000 && entered > 1000,
+            "{culled} culled, {entered} entered"
+        );
+    }
+
+    #[test]
+    fn a_box_touching_the_grown_segments_box_is_near() {
+        // The segment (0, 0)-(100, 0) grown by 16: its box is x in [-16, 116], y in [-16, 16].
+        let g = GrownSegment::new(Vec2::new(0.0, 0.0), Vec2::new(100.0, 0.0), 16.0);
+        let near = |lo: (f64, f64), hi: (f64, f64)| {
+            g.box_near(Vec2::new(lo.0, lo.1), Vec2::new(hi.0, hi.1))
+        };
+        assert!(near((116.5, 0.0), (200.0, 1.0)));
+        assert!(!near((117.5, 0.0), (200.0, 1.0)));
+        assert!(near((0.0, -40.0), (1.0, -16.5)));
+        assert!(!near((0.0, -40.0), (1.0, -17.5)));
+        assert!(near((-30.0, -30.0), (130.0, 30.0)));
     }
 
     #[test]
