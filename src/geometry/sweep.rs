@@ -99,7 +99,17 @@ impl Corridor {
     /// hull deeper than [`CONTACT_TOL_UNITS`] into one, or [`Cast::StartedInside`]. Rule boundaries are
     /// ignored (see [`Corridor::rule_violation_swept`]).
     pub fn cast(&self, pos: Vec2, delta: Vec2) -> Cast {
-        let solid = || self.pieces.iter().filter(|p| p.kind == BoundaryKind::Solid);
+        // Only the pieces near the move can hold its start or take it in (`GrownSegment::box_near`).
+        let end = pos + delta;
+        let (lo, hi) = (
+            Vec2::new(pos.x.min(end.x), pos.y.min(end.y)),
+            Vec2::new(pos.x.max(end.x), pos.y.max(end.y)),
+        );
+        let solid = || {
+            self.pieces
+                .iter()
+                .filter(move |p| p.kind == BoundaryKind::Solid && p.grown.box_near(lo, hi))
+        };
         let deepest = solid()
             .map(|p| (p.wall, p.grown.max_side(pos)))
             .min_by(|x, y| x.1.total_cmp(&y.1));
