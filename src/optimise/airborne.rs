@@ -141,13 +141,9 @@ pub(super) fn plan_airborne(
     let greedy_starts = certificate_greedy_starts(planner, base);
     let planning = Relaxation::planning(margins.planning);
     let side = move |fork: &mut Planner| certified_greedy_starts(fork, greedy_starts, planning, lo);
-    let mut plans_done = None;
-    let (mine, side_certifiers) = planner.beside_forks(vec![side], |planner| {
-        let mine = lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress);
-        plans_done = Some(Instant::now());
-        mine
+    let (mine, side_certifiers) = beside_certificate_starts(planner, vec![side], |planner| {
+        lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress)
     });
-    planner.seconds.certificate_wait += plans_done.map_or(0.0, seconds_since);
     // The relaxed line and the waits are clocked on their own, inside.
     planner.seconds.first_plans = seconds_since(first_started)
         - planner.seconds.relaxed_line
@@ -172,28 +168,29 @@ pub(super) fn plan_airborne(
         margins,
         greedy_s,
     };
-    let lines_started = Instant::now();
-    certificate_lines_rounded(
-        planner,
-        &mut certifier,
-        relaxed_line_frame,
-        terms,
-        progress,
-        &mut best,
+    planner.clocked(
+        |s| &mut s.certificate_lines,
+        |planner| {
+            let frame = relaxed_line_frame;
+            certificate_lines_rounded(planner, &mut certifier, frame, terms, progress, &mut best);
+        },
     );
-    planner.seconds.certificate_lines = seconds_since(lines_started);
-    let polish_started = Instant::now();
-    plan_polished_on(planner, &mut certifier, terms, progress, &mut best);
-    planner.seconds.polish_on = seconds_since(polish_started);
-    let round_started = Instant::now();
-    certificate_line_rounded_at_the_final_margin(
-        planner,
-        &mut certifier,
-        terms,
-        progress,
-        &mut best,
+    planner.clocked(
+        |s| &mut s.polish_on,
+        |planner| plan_polished_on(planner, &mut certifier, terms, progress, &mut best),
     );
-    planner.seconds.final_margin_round = seconds_since(round_started);
+    planner.clocked(
+        |s| &mut s.final_margin_round,
+        |planner| {
+            certificate_line_rounded_at_the_final_margin(
+                planner,
+                &mut certifier,
+                terms,
+                progress,
+                &mut best,
+            );
+        },
+    );
     AirbornePlan {
         best,
         certifier,
@@ -643,19 +640,11 @@ fn lines_and_plans(
     greedy_s: f64,
     progress: &mut dyn FnMut(Progress),
 ) -> Option<(Certifier, BestPlan, u64)> {
-    let relaxed_started = Instant::now();
-    let relaxed = relaxed_plan(
-        planner,
-        progress,
-        warm,
-        n,
-        lo,
-        Relaxation::planning(margins.planning),
-        Descent::PLAN,
-    )
-    .line;
-    planner.seconds.relaxed_line = seconds_since(relaxed_started);
-    let relaxed = relaxed?;
+    let planning = Relaxation::planning(margins.planning);
+    let relaxed = planner.clocked(
+        |s| &mut s.relaxed_line,
+        |planner| relaxed_plan(planner, progress, warm, n, lo, planning, Descent::PLAN).line,
+    )?;
     let relaxed_line_frame = planner.crossing_of(&relaxed).map_or(u64::MAX, |c| c.frames);
     let start = relaxed.clone();
     let certify = move |fork: &mut Planner| {
@@ -663,15 +652,33 @@ fn lines_and_plans(
         certifier.add_start(fork, &mut |_| {}, start, StartKind::Planned, lo);
         certifier
     };
-    let mut plans_done = None;
-    let (best, certifiers) = planner.beside_forks(vec![certify], |planner| {
-        let best = exact_plans_of_both_lines(planner, relaxed, lo, margins, greedy_s, progress);
-        plans_done = Some(Instant::now());
-        best
+    let (best, certifiers) = beside_certificate_starts(planner, vec![certify], |planner| {
+        exact_plans_of_both_lines(planner, relaxed, lo, margins, greedy_s, progress)
     });
-    planner.seconds.certificate_wait += plans_done.map_or(0.0, seconds_since);
     let certifier = certifiers.into_iter().next().unwrap_or_default();
     Some((certifier, best, relaxed_line_frame))
+}
+
+/// `here` on `planner` while the certificate's starts `jobs` run on forks of it
+/// ([`Planner::beside_forks`]); the time this thread then waits for them goes to the certificate wait of
+/// [`Planner::seconds`].
+fn beside_certificate_starts<'a, T, U, J>(
+    planner: &mut Planner<'a>,
+    jobs: Vec<J>,
+    here: impl FnOnce(&mut Planner<'a>) -> U,
+) -> (U, Vec<T>)
+where
+    J: FnOnce(&mut Planner<'a>) -> T + Send,
+    T: Send,
+{
+    let mut done = None;
+    let results = planner.beside_forks(jobs, |planner| {
+        let mine = here(planner);
+        done = Some(Instant::now());
+        mine
+    });
+    planner.seconds.certificate_wait += done.map_or(0.0, seconds_since);
+    results
 }
 
 /// The tight line refined from the relaxed one, and the exact plans of both lines.

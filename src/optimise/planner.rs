@@ -124,6 +124,19 @@ impl<'a> Planner<'a> {
         }
     }
 
+    /// `work` on this planner, its wall-clock seconds added to the stage `stage` picks of
+    /// [`Planner::seconds`].
+    pub(super) fn clocked<R>(
+        &mut self,
+        stage: fn(&mut StageSeconds) -> &mut f64,
+        work: impl FnOnce(&mut Self) -> R,
+    ) -> R {
+        let started = std::time::Instant::now();
+        let result = work(self);
+        *stage(&mut self.seconds) += started.elapsed().as_secs_f64();
+        result
+    }
+
     /// Adds the work of a [`Planner::fork`] done, and whether the budget cut it.
     pub(super) fn join(&mut self, forked: &Planner) {
         self.stats.add(&forked.stats);

@@ -597,9 +597,10 @@ fn solve_within(
     let greedy_s = time_of(greedy);
     let mut found = plan_airborne(&mut planner, &base, warm, n, lo, greedy_s, progress);
     if let Some(fine) = settings.fine_polish {
-        let fine_started = Instant::now();
-        plan_polished_finely(&mut planner, &mut found, fine, greedy_s, lo, progress);
-        planner.seconds.fine_polish = seconds_since(fine_started);
+        planner.clocked(
+            |s| &mut s.fine_polish,
+            |planner| plan_polished_finely(planner, &mut found, fine, greedy_s, lo, progress),
+        );
     }
     // The verification ends where the outcome takes the solve's time: the stages add up to it.
     let verification_from_s = seconds_since(started);
