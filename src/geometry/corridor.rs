@@ -4,7 +4,7 @@
 //! Performance: each query scans all segments (six dot products per segment for inside tests and casts), which
 //! is the right trade for corridors of tens of segments; a BVH would pay off only past about a hundred.
 
-use super::grown::GrownSegment;
+use super::grown::{move_box, GrownSegment, BOX_NEAR_UNITS};
 use super::wall::{BoundaryKind, Wall};
 use super::{CONTACT_TOL_UNITS, HULL_HALF_WIDTH_UNITS};
 use crate::error::{Error, Result};
@@ -130,13 +130,10 @@ impl Corridor {
     /// convex and the move linear.
     pub fn rule_violation_swept(&self, p0: Vec2, p1: Vec2) -> bool {
         let d = p1 - p0;
-        let (lo, hi) = (
-            Vec2::new(p0.x.min(p1.x), p0.y.min(p1.y)),
-            Vec2::new(p0.x.max(p1.x), p0.y.max(p1.y)),
-        );
+        let (lo, hi) = move_box(p0, p1);
         self.pieces
             .iter()
-            .filter(|p| p.kind == BoundaryKind::Rule && p.grown.box_near(lo, hi))
+            .filter(|p| p.kind == BoundaryKind::Rule && p.grown.box_near(lo, hi, BOX_NEAR_UNITS))
             .any(|p| {
                 p.grown
                     .open_interval(p0, d, CONTACT_TOL_UNITS)

@@ -25,9 +25,19 @@ pub(crate) struct Plane {
     pub offset: f64,
 }
 
-/// How far, units, beyond a grown segment's bounding box [`GrownSegment::box_near`] still counts a box as
-/// near: far more than rounding in the planes' sides could reach at corridor coordinates.
-const BOX_NEAR_UNITS: f64 = 1.0;
+/// How far, units, beyond a grown segment's bounding box a move's box still counts as near for the
+/// simulation's wall tests ([`GrownSegment::box_near`]): far more than rounding in the planes' sides could
+/// reach at corridor coordinates.
+pub(crate) const BOX_NEAR_UNITS: f64 = 1.0;
+
+/// The bounding box of the straight move from `p0` to `p1`: its lowest and highest corners.
+#[inline]
+pub(crate) fn move_box(p0: Vec2, p1: Vec2) -> (Vec2, Vec2) {
+    (
+        Vec2::new(p0.x.min(p1.x), p0.y.min(p1.y)),
+        Vec2::new(p0.x.max(p1.x), p0.y.max(p1.y)),
+    )
+}
 
 /// A segment grown by an axis-aligned box of half-width `half_width_units`.
 #[derive(Clone, Debug)]
@@ -146,17 +156,17 @@ impl GrownSegment {
         from_corners.min(from_ends)
     }
 
-    /// Whether the box from `lo` to `hi` comes within [`BOX_NEAR_UNITS`] of this grown segment's bounding
-    /// box. A move whose box does not cannot enter the segment: the test skips its planes, and keeps far
-    /// enough off that rounding in them could not have told otherwise.
+    /// Whether the box from `lo` to `hi` comes within `margin_units` of this grown segment's bounding
+    /// box. A move whose box does not cannot enter the segment, so a test may skip its planes. A box
+    /// with a coordinate that is not a number counts as near: its planes decide.
     #[inline]
-    pub fn box_near(&self, lo: Vec2, hi: Vec2) -> bool {
+    pub fn box_near(&self, lo: Vec2, hi: Vec2, margin_units: f64) -> bool {
         let half = self.hull.half_extents;
-        let (reach_x, reach_y) = (half.x + BOX_NEAR_UNITS, half.y + BOX_NEAR_UNITS);
-        self.a.x.max(self.b.x) + reach_x >= lo.x
-            && self.a.x.min(self.b.x) - reach_x <= hi.x
-            && self.a.y.max(self.b.y) + reach_y >= lo.y
-            && self.a.y.min(self.b.y) - reach_y <= hi.y
+        let (reach_x, reach_y) = (half.x + margin_units, half.y + margin_units);
+        !(self.a.x.max(self.b.x) + reach_x < lo.x
+            || self.a.x.min(self.b.x) - reach_x > hi.x
+            || self.a.y.max(self.b.y) + reach_y < lo.y
+            || self.a.y.min(self.b.y) - reach_y > hi.y)
     }
 
     /// Times at which `p + t d` is strictly inside this grown segment shrunk by `shrink_units` (a negative
@@ -245,6 +255,7 @@ fn convex_hull(mut pts: Vec<Vec2>) -> Vec<Vec2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_stream::Stream;
 
     #[test]
     fn diagonal_segment_grows_to_a_hexagon() {
@@ -259,17 +270,13 @@ mod tests {
         // Segments of every direction and moves of every length about them, from a fixed seed: wherever
         // the boxes are far apart, the planes say the move never enters either, so skipping them changes
         // no verdict; some moves are culled and some enter, so both branches are met.
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut stream = Stream(2026);
         let (mut culled, mut entered) = (0, 0);
         for _ in 0..20_000 {
-            let mut point =
-                |spread: f64| Vec2::new(spread * (next() - 0.5), spread * (next() - 0.5));
+            let mut point = |spread: f64| {
+                let half = 0.5 * spread;
+                Vec2::new(stream.within(-half, half), stream.within(-half, half))
+            };
             let (a, b) = (point(400.0), point(400.0));
             let g = GrownSegment::new(a, b, 16.0);
             let p0 = point(600.0);
@@ -277,9 +284,8 @@ mod tests {
             let enters = g
                 .open_interval(p0, p1 - p0, 0.0)
                 .is_some_and(|iv| iv.meets_unit_open());
-            let lo = Vec2::new(p0.x.min(p1.x), p0.y.min(p1.y));
-            let hi = Vec2::new(p0.x.max(p1.x), p0.y.max(p1.y));
-            if !g.box_near(lo, hi) {
+            let (lo, hi) = move_box(p0, p1);
+            if !g.box_near(lo, hi, BOX_NEAR_UNITS) {
                 culled += 1;
                 assert!(!enters, "{a:?}-{b:?}: {p0:?} -> {p1:?}");
             }
@@ -296,13 +302,17 @@ mod tests {
         // The segment (0, 0)-(100, 0) grown by 16: its box is x in [-16, 116], y in [-16, 16].
         let g = GrownSegment::new(Vec2::new(0.0, 0.0), Vec2::new(100.0, 0.0), 16.0);
         let near = |lo: (f64, f64), hi: (f64, f64)| {
-            g.box_near(Vec2::new(lo.0, lo.1), Vec2::new(hi.0, hi.1))
+            g.box_near(Vec2::new(lo.0, lo.1), Vec2::new(hi.0, hi.1), BOX_NEAR_UNITS)
         };
         assert!(near((116.5, 0.0), (200.0, 1.0)));
         assert!(!near((117.5, 0.0), (200.0, 1.0)));
         assert!(near((0.0, -40.0), (1.0, -16.5)));
         assert!(!near((0.0, -40.0), (1.0, -17.5)));
         assert!(near((-30.0, -30.0), (130.0, 30.0)));
+        // Without the margin the box itself is the edge; a box not a number is left to the planes.
+        assert!(g.box_near(Vec2::new(116.0, 0.0), Vec2::new(200.0, 1.0), 0.0));
+        assert!(!g.box_near(Vec2::new(116.5, 0.0), Vec2::new(200.0, 1.0), 0.0));
+        assert!(near((f64::NAN, 0.0), (f64::NAN, 1.0)));
     }
 
     #[test]

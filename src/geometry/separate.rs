@@ -5,7 +5,7 @@
 //! side keeps the whole straight move clear (a half-plane is convex).
 
 use super::corridor::Corridor;
-use super::grown::PLANE_COUNT;
+use super::grown::{move_box, PLANE_COUNT};
 use super::wall::BoundaryKind;
 use crate::physics::Vec2;
 
@@ -100,18 +100,16 @@ impl Corridor {
         kind: Option<BoundaryKind>,
         out: &mut Vec<Separation>,
     ) {
-        let lo = Vec2::new(p0.x.min(p1.x) - radius_units, p0.y.min(p1.y) - radius_units);
-        let hi = Vec2::new(p0.x.max(p1.x) + radius_units, p0.y.max(p1.y) + radius_units);
+        let (lo, hi) = move_box(p0, p1);
+        let reach = Vec2::new(radius_units, radius_units);
+        let (lo, hi) = (lo - reach, hi + reach);
         for piece in &self.pieces {
             if kind.is_some_and(|k| k != piece.kind) {
                 continue;
             }
             let g = &piece.grown;
             // Cheap rejection: the grown segment's bounding box against the move's, grown by the radius.
-            let h = super::HULL_HALF_WIDTH_UNITS;
-            let (gx0, gx1) = (g.a.x.min(g.b.x) - h, g.a.x.max(g.b.x) + h);
-            let (gy0, gy1) = (g.a.y.min(g.b.y) - h, g.a.y.max(g.b.y) + h);
-            if gx1 < lo.x || gx0 > hi.x || gy1 < lo.y || gy0 > hi.y {
+            if !g.box_near(lo, hi, 0.0) {
                 continue;
             }
             // The least-deep face: the plane of the grown segment that both ends are furthest outside.

@@ -10,6 +10,7 @@
 //! against a wall may slide along it, and moves that graze a corner or run exactly along a wall are free.
 
 use super::corridor::Corridor;
+use super::grown::{move_box, BOX_NEAR_UNITS};
 use super::wall::BoundaryKind;
 use super::{CONTACT_TOL_UNITS, MAX_BUMPS_PER_FRAME};
 use crate::physics::Vec2;
@@ -100,15 +101,11 @@ impl Corridor {
     /// ignored (see [`Corridor::rule_violation_swept`]).
     pub fn cast(&self, pos: Vec2, delta: Vec2) -> Cast {
         // Only the pieces near the move can hold its start or take it in (`GrownSegment::box_near`).
-        let end = pos + delta;
-        let (lo, hi) = (
-            Vec2::new(pos.x.min(end.x), pos.y.min(end.y)),
-            Vec2::new(pos.x.max(end.x), pos.y.max(end.y)),
-        );
+        let (lo, hi) = move_box(pos, pos + delta);
         let solid = || {
-            self.pieces
-                .iter()
-                .filter(move |p| p.kind == BoundaryKind::Solid && p.grown.box_near(lo, hi))
+            self.pieces.iter().filter(move |p| {
+                p.kind == BoundaryKind::Solid && p.grown.box_near(lo, hi, BOX_NEAR_UNITS)
+            })
         };
         let deepest = solid()
             .map(|p| (p.wall, p.grown.max_side(pos)))

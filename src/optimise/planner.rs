@@ -3,7 +3,7 @@
 
 use super::model::{frame_control_of, rollout, FrameControl, FrameLaw, ModelState};
 use super::scp::{run_scp, ScpProblem, StageKind};
-use super::search::{SearchSettings, SearchStats, StageSeconds};
+use super::search::{seconds_since, SearchSettings, SearchStats, StageSeconds};
 use super::LowerBound;
 use crate::budget::{Budget, Stage};
 use crate::physics::{Control, Vec2};
@@ -133,7 +133,7 @@ impl<'a> Planner<'a> {
     ) -> R {
         let started = std::time::Instant::now();
         let result = work(self);
-        *stage(&mut self.seconds) += started.elapsed().as_secs_f64();
+        *stage(&mut self.seconds) += seconds_since(started);
         result
     }
 
