@@ -120,6 +120,11 @@ pub struct SubStep {
     pub du: Vec<(f64, f64)>,
     /// Per frame, the model's change of the end position, units, when solved.
     pub dp: Vec<crate::physics::Vec2>,
+    /// Per frame, the model's change of the end state `(px, py, V, psi)`, when solved.
+    pub dx: Vec<[f64; 4]>,
+    /// Per frame, the feedback of its controls on the state change before it, where the frame-by-frame
+    /// solver gave the step ([`stagewise::ControlFeedback`]).
+    pub feedback: Option<Vec<stagewise::ControlFeedback>>,
     /// The model's predicted decrease of the merit (progress minus weighted violation), when solved.
     pub predicted: f64,
     /// Per frame, the duals `z` of its dynamics rows `(px, py, V, psi)` (Clarabel's convention
@@ -143,6 +148,8 @@ impl SubStep {
             status,
             du: vec![],
             dp: vec![],
+            dx: vec![],
+            feedback: None,
             predicted: 0.0,
             dynamics_duals: vec![],
             warm_start: None,
@@ -226,6 +233,7 @@ fn solve_limited(
         let step = sub_step_of(sp, &layout, status, s.x, s.dynamics_duals, s.iterations);
         return SubStep {
             warm_start: Some(s.warm_start),
+            feedback: s.feedback,
             ..step
         };
     }
@@ -523,14 +531,20 @@ fn sub_step_of(
             (change(0), change(1))
         })
         .collect();
-    let dp: Vec<crate::physics::Vec2> = (0..n)
-        .map(|k| crate::physics::Vec2::new(x[layout.ix(k, 0)], x[layout.ix(k, 1)]))
+    let dx: Vec<[f64; 4]> = (0..n)
+        .map(|k| std::array::from_fn(|i| x[layout.ix(k, i)]))
+        .collect();
+    let dp: Vec<crate::physics::Vec2> = dx
+        .iter()
+        .map(|d| crate::physics::Vec2::new(d[0], d[1]))
         .collect();
     let predicted = predicted_gain(sp, layout, &x);
     SubStep {
         status,
         du,
         dp,
+        dx,
+        feedback: None,
         predicted,
         dynamics_duals,
         warm_start: None,

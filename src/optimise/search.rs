@@ -247,6 +247,9 @@ pub struct SearchStats {
     /// Steps rejected by exact re-simulation but kept after a second-order correction (each such
     /// correction is one more sub-problem).
     pub corrected_steps: u64,
+    /// Steps rejected as played open-loop but accepted played with the sub-problem's feedback (each
+    /// such play one more simulation of the plan, no sub-problem).
+    pub fed_steps: u64,
     /// Frame counts tried.
     pub frame_counts_tried: u64,
     /// Exact-side plans played through the real frame with the wish direction set as the game can set
@@ -267,6 +270,7 @@ impl SearchStats {
         self.interior_point_iterations += other.interior_point_iterations;
         self.rejected_steps += other.rejected_steps;
         self.corrected_steps += other.corrected_steps;
+        self.fed_steps += other.fed_steps;
         self.frame_counts_tried += other.frame_counts_tried;
         self.replays += other.replays;
         self.valid_replays += other.valid_replays;

@@ -104,7 +104,15 @@ pub(super) struct StagedSolution {
     pub warm_start: WarmStart,
     /// Interior-point iterations taken.
     pub iterations: u32,
+    /// Per frame, the feedback of its controls `(sigma, c)` (c in ups) on the state change before it
+    /// `(px, py, V, psi)`, from the Newton system at the solution; `None` where that system could not be
+    /// factorised.
+    pub feedback: Option<Vec<ControlFeedback>>,
 }
+
+/// A frame's feedback: row `j` is control `j`'s change (`sigma`, then `c` in ups) per unit of each
+/// entry of the state change before the frame `(px, py, V, psi)`.
+pub type ControlFeedback = [[f64; 4]; 2];
 
 /// Why the frame-by-frame solver gave no solution (the caller then asks Clarabel).
 #[derive(Clone, Debug, PartialEq)]
@@ -463,9 +471,11 @@ pub(super) fn solve(
         }
         match tolerances.met(p, &frames, &offsets, &it) {
             Met::Solved => {
-                return Ok(solution(
-                    p, &frames, &wall_rows, &offsets, it, false, iteration,
-                ))
+                let feedback = feedback_at(&frames, &offsets, &it, &mut work.factors);
+                return Ok(StagedSolution {
+                    feedback,
+                    ..solution(p, &frames, &wall_rows, &offsets, it, false, iteration)
+                });
             }
             Met::Almost => almost = true,
             Met::Not => almost = false,
@@ -473,17 +483,56 @@ pub(super) fn solve(
         mehrotra_step(p, &frames, &offsets, &mut it, &mut work)?;
     }
     if almost {
-        return Ok(solution(
-            p,
-            &frames,
-            &wall_rows,
-            &offsets,
-            it,
-            true,
-            max_iterations,
-        ));
+        let feedback = feedback_at(&frames, &offsets, &it, &mut work.factors);
+        return Ok(StagedSolution {
+            feedback,
+            ..solution(p, &frames, &wall_rows, &offsets, it, true, max_iterations)
+        });
     }
     Err(NotStaged::MaxIterations)
+}
+
+/// Most weight a row has in the Newton system the feedback is taken from ([`feedback_at`]). At the
+/// solution an active row weighs `lambda / t`, near 1e12 where `t` is a hair from zero: the gains then
+/// hold every active row (a wall a frame is pressed on, a control at its trust bound) exactly, and a
+/// frame whose controls are all held by bounds has no feedback left to give. Capped, an active row
+/// still outweighs a frame's own curvature (the control regularisation is 1e-6) by orders of
+/// magnitude. On a narrow 100 fps corridor the steps played with the capped gains were kept in half the
+/// cases they were tried on, against 28 to 38 % uncapped or capped at 1e2 or 1e6 (docs/design.md, "A
+/// rejected step played again with the sub-problem's feedback").
+const FEEDBACK_ROW_WEIGHT_CAP: f64 = 1e4;
+
+/// Per frame, the feedback of its controls on the state change before it (see [`ControlFeedback`]):
+/// the Riccati gains `K_k = -Q_vv^-1 Q_vx` of the Newton system factorised at `it`, each row weighing
+/// `lambda / t` up to [`FEEDBACK_ROW_WEIGHT_CAP`], so that an active row's weight holds the feedback to
+/// it. A fixed control's row is zero; `None` where the system is not positive definite or a gain not
+/// finite.
+fn feedback_at(
+    frames: &[Frame],
+    offsets: &[usize],
+    it: &Iterate,
+    factors: &mut Vec<FrameFactor>,
+) -> Option<Vec<ControlFeedback>> {
+    factorised_capped(frames, offsets, it, factors, FEEDBACK_ROW_WEIGHT_CAP).ok()?;
+    let feedback = frames
+        .iter()
+        .zip(factors.iter())
+        .map(|(f, factor)| {
+            let mut rows = [[0.0; 4]; 2];
+            for (at, var) in f.vars.iter().enumerate() {
+                if let FrameVar::Control { j, .. } = *var {
+                    rows[j] = factor.gain[at].map(|g| g * control_scale(j));
+                }
+            }
+            rows
+        })
+        .collect::<Vec<_>>();
+    feedback
+        .iter()
+        .flatten()
+        .flatten()
+        .all(|g| g.is_finite())
+        .then_some(feedback)
 }
 
 /// Per frame, the index of its first row among all rows.
@@ -746,6 +795,17 @@ fn factorised(
     it: &Iterate,
     factors: &mut Vec<FrameFactor>,
 ) -> Result<(), NotStaged> {
+    factorised_capped(frames, offsets, it, factors, f64::INFINITY)
+}
+
+/// [`factorised`] with every row's weight `lambda / t` capped at `weight_cap`.
+fn factorised_capped(
+    frames: &[Frame],
+    offsets: &[usize],
+    it: &Iterate,
+    factors: &mut Vec<FrameFactor>,
+    weight_cap: f64,
+) -> Result<(), NotStaged> {
     // Every frame's entry is written below before any is read.
     factors.resize(frames.len(), FrameFactor::default());
     let mut value = [[0.0; 4]; 4];
@@ -754,6 +814,8 @@ fn factorised(
         let mut h = f.hessian;
         for (r, row) in f.rows.iter().enumerate() {
             let w = it.lambda[offsets[k] + r] / it.t[offsets[k] + r];
+            // Not `min`: a weight that is not a number stays one, and the factorisation fails on it.
+            let w = if w > weight_cap { weight_cap } else { w };
             if let Some(at) = row.bound {
                 h[4 + at][4 + at] += w;
                 continue;
@@ -1040,6 +1102,7 @@ fn solution(
             lambda: it.lambda,
         },
         iterations,
+        feedback: None,
     }
 }
 
@@ -1115,6 +1178,33 @@ mod tests {
                 offset: 0.0,
             },
         }
+    }
+
+    #[test]
+    fn the_feedback_holds_an_active_wall_sharing_a_deviation_among_the_frames_before_it() {
+        // Three frames whose sides move the position along y, progress along y, and a wall at the last
+        // frame's end (y <= 0.5): the wall binds. A deviation of y before frame 1 is taken back by the
+        // sides of frames 1 and 2 in equal shares (their changes weigh alike), one before frame 2 by
+        // frame 2's side alone; `c` moves x, which nothing asks for, and feeds back nothing.
+        let (mut sp, layout) = unit_chain(
+            3,
+            &[WallRow {
+                frame: 2,
+                ..wall(0)
+            }],
+        );
+        sp.progress_dir = Vec2::new(0.0, 1.0);
+        let solved = solve(&StagedProblem::new(&sp, &layout, &[0.5]), 100, 10.0, None);
+        let feedback = solved.ok().and_then(|s| s.feedback).unwrap_or_default();
+        assert_eq!(feedback.len(), 3);
+        let side_on_y = |k: usize| feedback[k][0][1];
+        assert!((side_on_y(1) + 0.5).abs() < 1e-3, "{feedback:?}");
+        assert!((side_on_y(2) + 1.0).abs() < 1e-3, "{feedback:?}");
+        let c_fed = feedback
+            .iter()
+            .flat_map(|f| f[1])
+            .fold(0.0_f64, |m, g| m.max(g.abs()));
+        assert!(c_fed < 1e-6, "{feedback:?}");
     }
 
     #[test]
