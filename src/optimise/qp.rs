@@ -82,6 +82,9 @@ pub struct SubProblem<'a> {
     pub wall_shift: Option<&'a [crate::physics::Vec2]>,
     /// The solver tried first.
     pub solver: SubProblemSolver,
+    /// Whether the frame-by-frame solver hands back its feedback with the step ([`SubStep::feedback`]):
+    /// for the stages that play a rejected step again with it (the relaxed ones, [`super::scp`]).
+    pub with_feedback: bool,
 }
 
 /// Which solver a sub-problem is given first.
@@ -793,6 +796,7 @@ mod tests {
             curvature: None,
             wall_shift: None,
             solver: SubProblemSolver::Riccati,
+            with_feedback: false,
         }
     }
 
@@ -888,6 +892,7 @@ mod tests {
         let ranges = [(1.0, 1.0)];
         let sp = SubProblem {
             solver: SubProblemSolver::Clarabel,
+            with_feedback: false,
             ..sub(&j, &p, &w, &ranges)
         };
         let r = solve_capped(&sp, 1);
@@ -1037,6 +1042,7 @@ mod tests {
                 curvature: self.curvature.as_deref(),
                 wall_shift: None,
                 solver: SubProblemSolver::Riccati,
+                with_feedback: false,
             }
         }
     }

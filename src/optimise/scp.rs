@@ -285,6 +285,7 @@ impl ScpProblem<'_> {
             curvature: lz.lin.curvature.as_deref(),
             wall_shift,
             solver: self.sub_problem_solver,
+            with_feedback: self.relaxed,
         }
     }
 

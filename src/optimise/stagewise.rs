@@ -471,7 +471,7 @@ pub(super) fn solve(
         }
         match tolerances.met(p, &frames, &offsets, &it) {
             Met::Solved => {
-                let feedback = feedback_at(&frames, &offsets, &it, &mut work.factors);
+                let feedback = feedback_at(p, &frames, &offsets, &it, &mut work.factors);
                 return Ok(StagedSolution {
                     feedback,
                     ..solution(p, &frames, &wall_rows, &offsets, it, false, iteration)
@@ -483,7 +483,7 @@ pub(super) fn solve(
         mehrotra_step(p, &frames, &offsets, &mut it, &mut work)?;
     }
     if almost {
-        let feedback = feedback_at(&frames, &offsets, &it, &mut work.factors);
+        let feedback = feedback_at(p, &frames, &offsets, &it, &mut work.factors);
         return Ok(StagedSolution {
             feedback,
             ..solution(p, &frames, &wall_rows, &offsets, it, true, max_iterations)
@@ -505,14 +505,18 @@ const FEEDBACK_ROW_WEIGHT_CAP: f64 = 1e4;
 /// Per frame, the feedback of its controls on the state change before it (see [`ControlFeedback`]):
 /// the Riccati gains `K_k = -Q_vv^-1 Q_vx` of the Newton system factorised at `it`, each row weighing
 /// `lambda / t` up to [`FEEDBACK_ROW_WEIGHT_CAP`], so that an active row's weight holds the feedback to
-/// it. A fixed control's row is zero; `None` where the system is not positive definite or a gain not
-/// finite.
+/// it. A fixed control's row is zero; `None` where `p` does not ask for it
+/// ([`SubProblem::with_feedback`]), the system is not positive definite or a gain not finite.
 fn feedback_at(
+    p: &StagedProblem,
     frames: &[Frame],
     offsets: &[usize],
     it: &Iterate,
     factors: &mut Vec<FrameFactor>,
 ) -> Option<Vec<ControlFeedback>> {
+    if !p.sp.with_feedback {
+        return None;
+    }
     factorised_capped(frames, offsets, it, factors, FEEDBACK_ROW_WEIGHT_CAP).ok()?;
     let feedback = frames
         .iter()
@@ -1154,6 +1158,7 @@ mod tests {
             curvature: None,
             wall_shift: None,
             solver: SubProblemSolver::Riccati,
+            with_feedback: false,
         };
         let layout = Layout::of(&sp);
         (sp, layout)
@@ -1285,6 +1290,7 @@ mod tests {
             curvature: Some(curvature),
             wall_shift: None,
             solver: SubProblemSolver::Riccati,
+            with_feedback: false,
         };
         let layout = Layout::of(&sp);
         (sp, layout)

@@ -141,6 +141,7 @@ impl SubStepSetup {
             curvature: None,
             wall_shift: None,
             solver: self.solver,
+            with_feedback: false,
         }
     }
 
