@@ -646,8 +646,9 @@ impl ScpSolver<'_> {
     }
 
     /// The plan a solved sub-step `step` (control changes `du`) leads to from `controls` (cost `cost`),
-    /// with its cost: played open-loop, or where that is rejected and the stage is relaxed, played with
-    /// the sub-problem's feedback ([`ScpProblem::stepped_with_feedback`]) if that comes out better.
+    /// with its cost: played open-loop, or where that is rejected and the sub-problem gave its feedback
+    /// (a relaxed stage's, [`SubProblem::with_feedback`]), played with it
+    /// ([`ScpProblem::stepped_with_feedback`]) if that comes out better.
     fn played(
         &mut self,
         problem: &mut Problem<ScpProblem<'_>>,
@@ -663,17 +664,12 @@ impl ScpSolver<'_> {
         if kept(cost - open_loop_cost, step.predicted) {
             return Ok((open_loop, open_loop_cost));
         }
-        let fed = match step.feedback.as_deref() {
-            Some(feedback) => problem.problem("feedback", |pr| {
-                Ok(pr
-                    .relaxed
-                    .then(|| pr.stepped_with_feedback(lz, controls, du, &step.dx, feedback)))
-            })?,
-            None => None,
-        };
-        let Some(fed) = fed else {
+        let Some(feedback) = step.feedback.as_deref() else {
             return Ok((open_loop, open_loop_cost));
         };
+        let fed = problem.problem("feedback", |pr| {
+            Ok(pr.stepped_with_feedback(lz, controls, du, &step.dx, feedback))
+        })?;
         let fed_cost = problem.cost(&fed).unwrap_or(f64::INFINITY);
         if fed_cost >= open_loop_cost {
             return Ok((open_loop, open_loop_cost));
