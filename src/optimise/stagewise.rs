@@ -1199,6 +1199,7 @@ mod tests {
             }],
         );
         sp.progress_dir = Vec2::new(0.0, 1.0);
+        sp.with_feedback = true;
         let solved = solve(&StagedProblem::new(&sp, &layout, &[0.5]), 100, 10.0, None);
         let feedback = solved.ok().and_then(|s| s.feedback).unwrap_or_default();
         assert_eq!(feedback.len(), 3);
