@@ -121,9 +121,8 @@ pub struct SubStep {
     pub status: SubStepStatus,
     /// Per frame `(d sigma, d c)` (c in ups), when solved.
     pub du: Vec<(f64, f64)>,
-    /// Per frame, the model's change of the end position, units, when solved.
-    pub dp: Vec<crate::physics::Vec2>,
-    /// Per frame, the model's change of the end state `(px, py, V, psi)`, when solved.
+    /// Per frame, the model's change of the end state `(px, py, V, psi)` (position in units), when
+    /// solved.
     pub dx: Vec<[f64; 4]>,
     /// Per frame, the feedback of its controls on the state change before it, where the frame-by-frame
     /// solver gave the step ([`stagewise::ControlFeedback`]).
@@ -145,12 +144,16 @@ pub struct SubStep {
 const FIXED_RANGE: f64 = 1e-12;
 
 impl SubStep {
+    /// The model's change of frame `k`'s end position, units.
+    pub fn dp(&self, k: usize) -> crate::physics::Vec2 {
+        crate::physics::Vec2::new(self.dx[k][0], self.dx[k][1])
+    }
+
     /// A sub-step with no step: `status` says why.
     fn failed(status: SubStepStatus) -> SubStep {
         SubStep {
             status,
             du: vec![],
-            dp: vec![],
             dx: vec![],
             feedback: None,
             predicted: 0.0,
@@ -537,15 +540,10 @@ fn sub_step_of(
     let dx: Vec<[f64; 4]> = (0..n)
         .map(|k| std::array::from_fn(|i| x[layout.ix(k, i)]))
         .collect();
-    let dp: Vec<crate::physics::Vec2> = dx
-        .iter()
-        .map(|d| crate::physics::Vec2::new(d[0], d[1]))
-        .collect();
     let predicted = predicted_gain(sp, layout, &x);
     SubStep {
         status,
         du,
-        dp,
         dx,
         feedback: None,
         predicted,
@@ -882,7 +880,7 @@ mod tests {
         for (r, side) in cases.chain(shifted.iter().map(|r| (r, 0.3))) {
             assert_eq!(r.status, SubStepStatus::Solved { almost: false });
             assert!((r.du[0].0 - side).abs() < 1e-6, "{:?}", r.du);
-            assert!((r.dp[0].y - side).abs() < 1e-6, "{:?}", r.dp);
+            assert!((r.dp(0).y - side).abs() < 1e-6, "{:?}", r.dx);
         }
     }
 

@@ -601,7 +601,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
                 &lz,
                 &controls,
                 &candidate,
-                &step.dp,
+                &step,
                 seconds_left,
             )? {
                 // Delivered enough of the first step's prediction: kept, the trust region as the
@@ -698,15 +698,15 @@ impl ScpSolver<'_> {
     /// to units, so a step that the sub-problem kept clear can land in a wall, and the merit charges that
     /// at the slack weight. The sub-problem is solved again about the same linearisation with each frame's
     /// wall rows moved by what the model left out of the trial's position (`candidate` played, less the
-    /// model's position after the step, `step_dp` being its change), and the corrected plan and its cost
-    /// come back.
+    /// model's position after the step, [`qp::SubStep::dp`] its change), and the corrected plan and its
+    /// cost come back.
     fn second_order_correction(
         &mut self,
         problem: &mut Problem<ScpProblem<'_>>,
         lz: &Linearisation,
         controls: &[FrameControl],
         candidate: &[f64],
-        step_dp: &[Vec2],
+        step: &qp::SubStep,
         seconds_left: f64,
     ) -> std::result::Result<Option<(Vec<f64>, f64)>, ArgminError> {
         let corrected = problem.problem("correct", |pr| {
@@ -719,8 +719,8 @@ impl ScpSolver<'_> {
             let left_out: Vec<Vec2> = trial
                 .iter()
                 .zip(&lz.lin.positions)
-                .zip(step_dp)
-                .map(|((t, p), dp)| t.pos - (*p + *dp))
+                .enumerate()
+                .map(|(k, (t, p))| t.pos - (*p + step.dp(k)))
                 .collect();
             Ok(Some(qp::solve_warm(
                 &pr.sub_problem(lz, Some(&left_out)),
@@ -906,7 +906,7 @@ mod tests {
         let mut furthest = 0.0_f64;
         for (k, jac) in lz.lin.jacobians.iter().enumerate() {
             dx = jac.state_change(&dx, &[step.du[k].0, step.du[k].1]);
-            furthest = furthest.max((Vec2::new(dx[0], dx[1]) - step.dp[k]).length());
+            furthest = furthest.max((Vec2::new(dx[0], dx[1]) - step.dp(k)).length());
         }
         assert!(furthest < 1e-9, "{furthest} units apart");
     }

@@ -471,11 +471,9 @@ pub(super) fn solve(
         }
         match tolerances.met(p, &frames, &offsets, &it) {
             Met::Solved => {
-                let feedback = feedback_at(p, &frames, &offsets, &it, &mut work.factors);
-                return Ok(StagedSolution {
-                    feedback,
-                    ..solution(p, &frames, &wall_rows, &offsets, it, false, iteration)
-                });
+                return Ok(solution(
+                    p, &frames, &wall_rows, &offsets, it, false, iteration,
+                ));
             }
             Met::Almost => almost = true,
             Met::Not => almost = false,
@@ -483,11 +481,15 @@ pub(super) fn solve(
         mehrotra_step(p, &frames, &offsets, &mut it, &mut work)?;
     }
     if almost {
-        let feedback = feedback_at(p, &frames, &offsets, &it, &mut work.factors);
-        return Ok(StagedSolution {
-            feedback,
-            ..solution(p, &frames, &wall_rows, &offsets, it, true, max_iterations)
-        });
+        return Ok(solution(
+            p,
+            &frames,
+            &wall_rows,
+            &offsets,
+            it,
+            true,
+            max_iterations,
+        ));
     }
     Err(NotStaged::MaxIterations)
 }
@@ -512,12 +514,12 @@ fn feedback_at(
     frames: &[Frame],
     offsets: &[usize],
     it: &Iterate,
-    factors: &mut Vec<FrameFactor>,
 ) -> Option<Vec<ControlFeedback>> {
     if !p.sp.with_feedback {
         return None;
     }
-    factorised_capped(frames, offsets, it, factors, FEEDBACK_ROW_WEIGHT_CAP).ok()?;
+    let mut factors = Vec::new();
+    factorised_capped(frames, offsets, it, &mut factors, FEEDBACK_ROW_WEIGHT_CAP).ok()?;
     let feedback = frames
         .iter()
         .zip(factors.iter())
@@ -1043,7 +1045,7 @@ fn cholesky_solve_sized<const N: usize>(
 /// gradient of the Lagrangian in the state change after frame `k` through all later frames (its
 /// direct terms: the next frame's curvature, the last frame's progress and the wall rows of frame `k`'s
 /// end, which the frames hold through their dynamics and so are added back here), reached after
-/// `iterations`.
+/// `iterations`; with the feedback at it where `p` asks for it ([`feedback_at`]).
 fn solution(
     p: &StagedProblem,
     frames: &[Frame],
@@ -1097,6 +1099,7 @@ fn solution(
         duals[k] = adjoint.map(|a| -a);
     }
     StagedSolution {
+        feedback: feedback_at(p, frames, offsets, &it),
         x,
         dynamics_duals: duals,
         almost,
@@ -1106,7 +1109,6 @@ fn solution(
             lambda: it.lambda,
         },
         iterations,
-        feedback: None,
     }
 }
 
