@@ -606,3 +606,33 @@ fn a_seed_that_never_reaches_the_line_is_planned_over_twice_the_bounds_frames_no
         "counts {counts:?} against the bound's {bound_frames} frames"
     );
 }
+
+#[test]
+fn a_greedy_run_sliding_along_a_wall_ahead_of_every_plan_is_returned_and_said_so() {
+    // Generated scene 13 of seed 1313 (CI-sized family: 100 fps, air acceleration 10, two left turns, 96
+    // units wide, solid walls, in at 1,346 ups): the greedy run slides along a wall and crosses in frame
+    // 87, the relaxed optimum (clear of the walls) in frame 93. Its plans replay valid but slower, so the
+    // greedy run is returned, and the status says that, not that no plan stayed valid.
+    let scene = generate(1313, 13, &GeneratorSettings::ci_sized())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .scene;
+    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(o.source, "greedy", "{:?}", o.status);
+    assert!(
+        o.greedy.min_clearance() < 1e-6,
+        "{}",
+        o.greedy.min_clearance()
+    );
+    let relaxed = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
+    let greedy = o.greedy.crossing.unwrap_or_else(|| panic!("no crossing"));
+    assert!(
+        relaxed.frames > greedy.frames,
+        "{relaxed:?} against {greedy:?}"
+    );
+    assert!(o.stats.valid_replays > 0, "{:?}", o.stats);
+    let SearchStatus::NoImprovement { reason } = &o.status else {
+        panic!("{:?}", o.status)
+    };
+    assert!(reason.contains("slower than the greedy run"), "{reason}");
+}

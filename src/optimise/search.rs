@@ -624,11 +624,7 @@ fn solve_within(
             finisher.outcome(trace.controls.clone(), trace, status, stats, "optimised")
         }
         None => {
-            let reason = if found.relaxed_found {
-                "no optimised plan stayed valid after rounding and quantisation"
-            } else {
-                "the relaxed search found no valid plan"
-            };
+            let reason = no_improvement_reason(found.relaxed_found, &stats);
             finisher.greedy_outcome(
                 stopped.unwrap_or_else(|| SearchStatus::NoImprovement {
                     reason: reason.into(),
@@ -648,6 +644,19 @@ fn solve_within(
         stage_seconds,
         ..outcome
     })
+}
+
+/// Why no optimised plan was returned, from whether the relaxed stage found a line and the replays
+/// `stats` counted: none found, none of its plans replayed valid, or every plan that did was slower than
+/// the greedy run (a greedy run that slides along a wall can be ahead of every plan clear of the walls).
+fn no_improvement_reason(relaxed_found: bool, stats: &SearchStats) -> &'static str {
+    if !relaxed_found {
+        "the relaxed search found no valid plan"
+    } else if stats.valid_replays == 0 {
+        "no optimised plan stayed valid after rounding and quantisation"
+    } else {
+        "every optimised plan that stayed valid was slower than the greedy run"
+    }
 }
 
 /// Scenes with ground frames, gravity or jumps: greedy when it already crosses in the bound's frame
