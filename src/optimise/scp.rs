@@ -323,10 +323,7 @@ impl ScpProblem<'_> {
             let (c_lo, c_hi) = lz.c_range[k];
             let ds = (du[k].0 + fed(0)).clamp(-s_lo, s_hi);
             let dc = (du[k].1 + fed(1)).clamp(-c_lo, c_hi);
-            let u = FrameControl {
-                sigma: (controls[k].sigma + ds).clamp(-1.0, 1.0),
-                c: controls[k].c + dc,
-            };
+            let u = moved(&controls[k], (ds, dc));
             x = knot(&x, u, &self.fl, self.frames_per_knot, false).0;
             out.extend([u.sigma, u.c]);
         }
@@ -439,8 +436,19 @@ fn stepped(controls: &[FrameControl], du: &[(f64, f64)]) -> Vec<f64> {
     controls
         .iter()
         .zip(du)
-        .flat_map(|(u, d)| [(u.sigma + d.0).clamp(-1.0, 1.0), u.c + d.1])
+        .flat_map(|(u, d)| {
+            let m = moved(u, *d);
+            [m.sigma, m.c]
+        })
         .collect()
+}
+
+/// The control `u` moved by `(d sigma, d c)`, its side kept in `[-1, 1]`.
+fn moved(u: &FrameControl, (d_sigma, d_c): (f64, f64)) -> FrameControl {
+    FrameControl {
+        sigma: (u.sigma + d_sigma).clamp(-1.0, 1.0),
+        c: u.c + d_c,
+    }
 }
 
 /// The largest trust radius.
