@@ -12,6 +12,8 @@
 //!   [`Corridor::sweep`] (GoldSrc `PM_FlyMove`: clip and retry up to [`MAX_BUMPS_PER_FRAME`] times).
 //! - [`finish`]: [`FinishLine`] and the fraction of a move at which it is crossed.
 //! - [`path`]: [`Corridor::shortest_path`], the exact shortest path of the hull centre (a lower bound).
+//! - [`racing_line`]: [`racing_line::RacingLine`], the line through the corridor that bends least (a guide
+//!   of the greedy baseline).
 //!
 //! [`Vec2`]: crate::physics::Vec2
 
@@ -19,6 +21,7 @@ pub mod corridor;
 pub mod finish;
 mod grown;
 pub mod path;
+pub mod racing_line;
 pub mod separate;
 pub mod sweep;
 pub mod wall;

@@ -6,18 +6,23 @@
 //! guides: the corridor's shortest path kept 0 to 40 units off the walls and
 //! the centre line (the guide kept as far off the walls as the corridor allows), every look-ahead, then on
 //! airborne scenes the same turning as sharply as its target needs (section 9: the frame that turns that
-//! far for the least speed), and with speed caps and corner speeds from the radius-speed relation. The fastest
-//! valid run whose engine-exact replay is valid too is the baseline (else the fastest valid run), and
-//! which guide gave it is reported. Scenes with ground movement (groundstrafing, jumping) run capped too,
+//! far for the least speed), and with speed caps and corner speeds from the radius-speed relation, and
+//! along racing lines ([`RacingLine`]: the line through the corridor that bends least) at the speeds of
+//! their curvature. The fastest valid run whose engine-exact replay is valid too is the baseline (else the
+//! fastest valid run), and which guide gave it is reported. The search starts from the strafer's own
+//! clean runs, not the racing lines' ([`starts`]). Scenes with ground movement (groundstrafing, jumping) run capped too,
 //! with caps that are shares of the groundstrafing top speed as well (section 12), but only when no
 //! uncapped run is valid in both arithmetics: maximum acceleration overshoots a sharp corner of a narrow
 //! corridor, and scraping along a solid wall it parts ways with the game's f32 replay.
 
 use super::LowerBound;
 use crate::budget::Budget;
+use crate::geometry::racing_line::RacingLine;
 use crate::geometry::{Corridor, HULL_HALF_WIDTH_UNITS};
 use crate::physics::closed_form::max_groundstrafe_speed;
-use crate::physics::curvature::{air_law, bend_arc_radius, speed_for_radius, turn_arc_radius};
+use crate::physics::curvature::{
+    air_law, bend_arc_radius, circumradius, speed_for_radius, turn_arc_radius, RadiusSpeedTable,
+};
 use crate::physics::{Effect, Vec2};
 use crate::scene::Scene;
 use crate::sim::controllers::{CornerSpeed, CornerSpeeds, Greedy, GREEDY_LOOKAHEADS_UNITS};
@@ -66,11 +71,21 @@ pub struct GreedyGuide {
     /// Whether the strafer turns as sharply as its target needs (uncapped; see
     /// [`Greedy::with_sharp_turns`]).
     pub sharp_turns: bool,
+    /// Whether the guide is a racing line ([`RacingLine`], `clearance_units` off the walls), taken at
+    /// the speeds of this share of its curvature's radii (see `baseline.rs::curvature_speeds`).
+    pub racing_line: Option<f64>,
 }
 
 impl std::fmt::Display for GreedyGuide {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.centre_line {
+        if let Some(share) = self.racing_line {
+            write!(
+                f,
+                "racing line ({:.1} units off the walls) at the speeds of {:.0} % of its radii",
+                self.clearance_units,
+                100.0 * share
+            )?;
+        } else if self.centre_line {
             write!(
                 f,
                 "centre line ({:.1} units off the walls)",
@@ -222,6 +237,67 @@ fn corner_speeds(scene: &Scene, path: &[Vec2], width_units: f64) -> CornerSpeeds
     }
 }
 
+/// The speeds a strafer along the racing line `line` keeps under: at each of its points the speed whose
+/// maximum-acceleration radius (docs/physics.md section 9) is the radius of the circle through it and its
+/// neighbours, and before it what braking at `gamma1` a frame (section 7) can bring down to it.
+fn curvature_speeds(scene: &Scene, line: &[Vec2], radius_share: f64) -> CornerSpeeds {
+    binding(point_speeds(scene, line, radius_share))
+}
+
+/// [`curvature_speeds`] at every point of `line`, each a stretch of no length.
+fn point_speeds(scene: &Scene, line: &[Vec2], radius_share: f64) -> CornerSpeeds {
+    let table = RadiusSpeedTable::new(&scene.vars);
+    let mut corners = Vec::new();
+    let mut s = 0.0;
+    for w in line.windows(3) {
+        s += (w[1] - w[0]).length();
+        if let Some(speed_ups) = table.speed_for(radius_share * circumradius(w[0], w[1], w[2])) {
+            corners.push(CornerSpeed {
+                start_units: s,
+                end_units: s,
+                speed_ups,
+            });
+        }
+    }
+    CornerSpeeds {
+        corners,
+        braking_ups_per_s: air_law(&scene.vars).gamma1 / scene.frame_time_s(),
+    }
+}
+
+/// The points of `speeds` (stretches of no length, in order along the line) that bind: a point whose
+/// speed braking for a later point already keeps under limits nothing, and is dropped, so that the
+/// strafer weighs a few points a frame instead of every point of the line.
+fn binding(speeds: CornerSpeeds) -> CornerSpeeds {
+    let braking = speeds.braking_ups_per_s;
+    let mut kept: Vec<CornerSpeed> = Vec::with_capacity(speeds.corners.len());
+    for c in speeds.corners.into_iter().rev() {
+        let braked_ups = kept.last().map_or(f64::INFINITY, |next| {
+            (next.speed_ups * next.speed_ups + 2.0 * braking * (next.start_units - c.start_units))
+                .sqrt()
+        });
+        if c.speed_ups < braked_ups {
+            kept.push(c);
+        }
+    }
+    kept.reverse();
+    CornerSpeeds {
+        corners: kept,
+        braking_ups_per_s: braking,
+    }
+}
+
+/// Shares of a racing line's radii whose speeds the strafer keeps under: the line's own, and slower for
+/// where the strafer falls behind the line's turn and strays outwards (the turn of a frame at a speed,
+/// about `min(L, gamma1) / |v|`, leaves it little room to catch up). Measured on three generated
+/// families, the line's own speeds gave the baseline 18 times of 20 and 80 % the other two; 60 and 40 %
+/// never did (docs/design.md, "The racing line").
+const RACING_RADIUS_SHARES: [f64; 2] = [1.0, 0.8];
+
+/// Margins of the racing lines off the walls, units (beyond the hull's half width): the strafer
+/// tracking a line strays from it by a few units.
+const RACING_LINE_MARGINS_UNITS: [f64; 3] = [4.0, 12.0, 24.0];
+
 /// Shares of the groundstrafing top speed (docs/physics.md section 12) the ground's capped greedy runs
 /// hold.
 const GROUND_CAP_SHARES: [f64; 6] = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8];
@@ -242,6 +318,7 @@ fn ground_caps(scene: &Scene, path: &[Vec2]) -> Vec<f64> {
 struct GuidePath {
     clearance_units: f64,
     centre_line: bool,
+    racing_line: bool,
     path: Vec<Vec2>,
 }
 
@@ -253,6 +330,8 @@ enum Cornering {
     Cap(f64),
     CornerSpeeds(f64),
     SharpTurns,
+    /// Along a racing line, under the speeds of its curvature, turning as sharply as needed.
+    Curvature(f64),
 }
 
 /// The guide paths of `scene`: the shortest path (the lower bound's) and the paths kept each of
@@ -261,6 +340,7 @@ fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
     let mut guides = vec![GuidePath {
         clearance_units: 0.0,
         centre_line: false,
+        racing_line: false,
         path: bound.path.clone(),
     }];
     for &extra in &GUIDE_CLEARANCES_UNITS[1..] {
@@ -268,6 +348,7 @@ fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
             Some(path) => guides.push(GuidePath {
                 clearance_units: extra,
                 centre_line: false,
+                racing_line: false,
                 path,
             }),
             None => break,
@@ -281,11 +362,37 @@ fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
             guides.push(GuidePath {
                 clearance_units: extra,
                 centre_line: true,
+                racing_line: false,
                 path,
             });
         }
     }
+    if scene.effects.is_air_only() {
+        let lines = racing_lines(scene, &guides[guides.len() - 1]);
+        guides.extend(lines);
+    }
     guides
+}
+
+/// The racing lines ([`RacingLine`]) along the widest guide `widest`, one at each of
+/// [`RACING_LINE_MARGINS_UNITS`] it has room for.
+fn racing_lines(scene: &Scene, widest: &GuidePath) -> Vec<GuidePath> {
+    let Ok(corridor) = Corridor::new(&scene.walls) else {
+        return Vec::new();
+    };
+    RACING_LINE_MARGINS_UNITS
+        .iter()
+        .filter(|&&m| m <= widest.clearance_units)
+        .filter_map(|&m| {
+            let line = RacingLine::through(&corridor, &widest.path, m)?;
+            Some(GuidePath {
+                clearance_units: m,
+                centre_line: false,
+                racing_line: true,
+                path: line.points,
+            })
+        })
+        .collect()
 }
 
 /// The shortest path kept `extra_units` further off every wall than the hull needs, if there is one.
@@ -368,8 +475,7 @@ pub(super) fn baseline(
         );
         greedy = pick_greedy(sim, &guides, &runs, &checked, budget);
     }
-    let clean = runs
-        .clean
+    let clean = starts(runs.clean)
         .into_iter()
         .take(MAX_STARTS)
         .map(|(_, i, guide)| replay(sim, &guides, i, guide))
@@ -381,11 +487,26 @@ pub(super) fn baseline(
     }
 }
 
+/// The starts of the relaxed problem among the clean runs `clean` (fastest first): the strafer's own
+/// along its guides, not the racing lines' ([`Cornering::Curvature`]). A racing-line run is often nearer
+/// the plan, but as a start it was measured to save no time (docs/design.md, "The racing line").
+fn starts(clean: Vec<(f64, usize, GreedyGuide)>) -> Vec<(f64, usize, GreedyGuide)> {
+    clean
+        .into_iter()
+        .filter(|r| r.2.racing_line.is_none())
+        .collect()
+}
+
 /// The airborne ways of keeping the speed down for corners along `path`: the speed caps
 /// ([`corner_caps`]), then the corner speeds of bends of each of [`CAP_WIDTHS_UNITS`].
 fn speed_limits(scene: &Scene, path: &[Vec2]) -> impl Iterator<Item = Cornering> {
     let caps = corner_caps(scene, path).into_iter().map(Cornering::Cap);
     caps.chain(CAP_WIDTHS_UNITS.iter().map(|&w| Cornering::CornerSpeeds(w)))
+        .chain(
+            RACING_RADIUS_SHARES
+                .iter()
+                .map(|&k| Cornering::Curvature(k)),
+        )
 }
 
 /// The verdicts of the greedy runs swept so far, each as its crossing time (or rank), guide index and
@@ -418,9 +539,13 @@ fn strafer(path: &[Vec2], guide: &GreedyGuide, corners: Option<&CornerSpeeds>) -
 
 /// The strafer of `guide` along `path`, its corner speeds worked out for it.
 fn strafer_of(sim: &Simulation, path: &[Vec2], guide: &GreedyGuide) -> Greedy {
-    let corners = guide
-        .corner_bend_units
-        .map(|w| corner_speeds(sim.scene(), path, w));
+    let corners = if let Some(share) = guide.racing_line {
+        Some(curvature_speeds(sim.scene(), path, share))
+    } else {
+        guide
+            .corner_bend_units
+            .map(|w| corner_speeds(sim.scene(), path, w))
+    };
     strafer(path, guide, corners.as_ref())
 }
 
@@ -449,14 +574,21 @@ fn sweep_guides(
     // Speed-limited runs along the shortest path and the widest guide only: the limits are for corners
     // the uncapped strafer overshoots, and every guide in between would multiply the runs. Sharp turns
     // keep the speed, so the guide they follow matters as much as the plain strafer's.
-    let last = guides.len() - 1;
+    let last = guides.iter().rposition(|g| !g.racing_line).unwrap_or(0);
     let jobs: Vec<(Option<Cornering>, usize)> = first
         .into_iter()
         .chain(cornering.iter().copied().map(Some))
         .flat_map(|way| {
             let limited = matches!(way, Some(Cornering::Cap(_) | Cornering::CornerSpeeds(_)));
+            let racing = matches!(way, Some(Cornering::Curvature(_)));
             (0..guides.len())
-                .filter(move |&i| !limited || i == 0 || i == last)
+                .filter(move |&i| {
+                    if guides[i].racing_line {
+                        racing
+                    } else {
+                        !racing && (!limited || i == 0 || i == last)
+                    }
+                })
                 .map(move |i| (way, i))
         })
         .collect();
@@ -502,15 +634,19 @@ fn sweep_guide(
     broken_frame_limit: u64,
     budget: &Budget,
 ) -> GuideSweep {
-    let (cap, corner_bend_units, sharp_turns) = match way {
-        None => (None, None, false),
-        Some(Cornering::Cap(cap)) => (Some(cap), None, false),
-        Some(Cornering::CornerSpeeds(w)) => (None, Some(w), false),
-        Some(Cornering::SharpTurns) => (None, None, true),
+    let (cap, corner_bend_units, sharp_turns, racing_line) = match way {
+        None => (None, None, false, None),
+        Some(Cornering::Cap(cap)) => (Some(cap), None, false, None),
+        Some(Cornering::CornerSpeeds(w)) => (None, Some(w), false, None),
+        Some(Cornering::SharpTurns) => (None, None, true, None),
+        Some(Cornering::Curvature(share)) => (None, None, true, Some(share)),
     };
     let g = &guides[i];
     // The corner speeds along this guide, the same at every look-ahead.
-    let corners = corner_bend_units.map(|w| corner_speeds(sim.scene(), &g.path, w));
+    let corners = match racing_line {
+        Some(share) => Some(curvature_speeds(sim.scene(), &g.path, share)),
+        None => corner_bend_units.map(|w| corner_speeds(sim.scene(), &g.path, w)),
+    };
     let mut swept = GuideSweep {
         clean: None,
         valid: None,
@@ -531,6 +667,7 @@ fn sweep_guide(
             speed_cap_ups: cap,
             corner_bend_units,
             sharp_turns,
+            racing_line,
         };
         let run = sim.run_summary_broken_until(
             &mut strafer(&g.path, &guide, corners.as_ref()),
@@ -608,6 +745,7 @@ fn pick_greedy(
                 speed_cap_ups: None,
                 corner_bend_units: None,
                 sharp_turns: false,
+                racing_line: None,
             };
             GuideRun {
                 guide,
@@ -632,6 +770,75 @@ mod tests {
     use crate::optimise::planner::{
         fast_hairpin_at_air_acceleration_100, planning_inputs, staircase_scene,
     };
+
+    /// Scene `index` of the narrow family at air acceleration 10 (`strafeopt gen --seed 5151 --fps 100
+    /// --airaccelerate 10 --max-width 128 --max-corners 4 --max-leg 1000`).
+    fn narrow_scene(index: u64) -> Scene {
+        use crate::scene::generate::{generate, GeneratorSettings};
+        let settings = GeneratorSettings {
+            fps: vec![100],
+            airaccelerate: vec![10],
+            max_width_units: 128,
+            max_corners: 4,
+            max_leg_units: 1000,
+            ..GeneratorSettings::default()
+        };
+        generate(5151, index, &settings)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .scene
+    }
+
+    #[test]
+    fn a_racing_line_keeps_only_its_binding_points_and_limits_the_same() {
+        let scene = narrow_scene(3);
+        let (_, bound, _) = planning_inputs(&scene);
+        let guides = guide_paths(&scene, &bound);
+        let line = guides
+            .iter()
+            .find(|g| g.racing_line)
+            .unwrap_or_else(|| panic!("no racing line"));
+        let every = point_speeds(&scene, &line.path, 1.0);
+        let kept = binding(every.clone());
+        assert!(
+            kept.corners.len() < every.corners.len(),
+            "{} of {}",
+            kept.corners.len(),
+            every.corners.len()
+        );
+        let end = every.corners.last().map_or(0.0, |c| c.end_units);
+        for k in 0..=2000 {
+            let s = end * k as f64 / 2000.0;
+            match (every.cap_at(s), kept.cap_at(s)) {
+                (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-9 * a, "at {s}: {a} {b}"),
+                (a, b) => assert_eq!(a, b, "at {s}"),
+            }
+        }
+    }
+
+    #[test]
+    fn on_a_narrow_corridor_the_racing_line_is_the_baseline_but_not_a_start() {
+        // 100 fps, air acceleration 10, four turns 64 to 128 units wide: the strafer's own runs slow
+        // for every corner along their guides; the racing line's speeds let it carry more.
+        let scene = narrow_scene(3);
+        let (_, _, base) = planning_inputs(&scene);
+        let greedy = base
+            .greedy
+            .trace
+            .crossing
+            .unwrap_or_else(|| panic!("no greedy crossing"));
+        assert!(base.greedy.trace.feasible());
+        assert!(
+            base.greedy.guide.racing_line.is_some(),
+            "{}",
+            base.greedy.guide
+        );
+        let seed = base
+            .seed()
+            .crossing
+            .unwrap_or_else(|| panic!("no seed crossing"));
+        assert!(greedy.frames < seed.frames, "{greedy:?} {seed:?}");
+        assert!(base.clean.iter().all(|r| r.guide.racing_line.is_none()));
+    }
 
     #[test]
     fn a_corner_wrapped_by_several_vertices_counts_as_one_turn() {

@@ -160,6 +160,59 @@ pub fn speed_for_radius_source_text(vars: &MovementVars, radius: f64) -> Result<
     )
 }
 
+/// [`speed_for_radius`] tabulated once for many radii: the measured radius (docs/physics.md section 9) at
+/// [`RadiusSpeedTable::SPEEDS`] even steps of speed up to `sv_maxvelocity`, read back by linear
+/// interpolation on its rising branch. A line of hundreds of points asks for the speed of each.
+#[derive(Clone, Debug)]
+pub struct RadiusSpeedTable {
+    /// `(speed ups, measured radius units)` on the rising branch, slowest first.
+    rising: Vec<(f64, f64)>,
+}
+
+impl RadiusSpeedTable {
+    /// Speeds tabulated, evenly up to `sv_maxvelocity`.
+    pub const SPEEDS: usize = 512;
+
+    /// The table of `vars`.
+    pub fn new(vars: &MovementVars) -> Self {
+        let table: Vec<(f64, f64)> = (1..=Self::SPEEDS)
+            .map(|j| {
+                let v = vars.maxvelocity * j as f64 / Self::SPEEDS as f64;
+                (v, measured_radius(vars, v))
+            })
+            .filter(|(_, r)| r.is_finite())
+            .collect();
+        // The rising branch: from the tightest radius on.
+        let tightest = table
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+            .map_or(0, |(i, _)| i);
+        let mut rising: Vec<(f64, f64)> = Vec::with_capacity(table.len() - tightest);
+        for &(v, r) in &table[tightest..] {
+            if rising.last().is_none_or(|&(_, last)| r > last) {
+                rising.push((v, r));
+            }
+        }
+        RadiusSpeedTable { rising }
+    }
+
+    /// The speed whose maximum-acceleration radius is `radius_units`, ups: the tightest radius's speed
+    /// below it, `None` where even `sv_maxvelocity` turns tighter (no limit).
+    pub fn speed_for(&self, radius_units: f64) -> Option<f64> {
+        let last = self.rising.last()?;
+        if radius_units >= last.1 {
+            return None;
+        }
+        let k = self.rising.partition_point(|&(_, r)| r <= radius_units);
+        if k == 0 {
+            return Some(self.rising[0].0);
+        }
+        let ((v0, r0), (v1, r1)) = (self.rising[k - 1], self.rising[k]);
+        Some(v0 + (v1 - v0) * (radius_units - r0) / (r1 - r0))
+    }
+}
+
 /// Solves `f(v) = target` for `v` in `(0, v_max]` on the branch where `f` increases. Below `L - gamma1`
 /// maximum acceleration goes straight ahead (infinite radius), so the radius first falls with speed and then
 /// rises: the smallest radius is located by a log-spaced scan refined by golden section, and the target is
@@ -225,6 +278,33 @@ fn invert_rising_branch(f: impl Fn(f64) -> f64, target: f64, v_max: f64) -> Resu
 mod tests {
     use super::*;
     use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn the_tabulated_speed_of_a_radius_is_the_root_finders() {
+        for (fps, airaccelerate) in [(100.0, 10.0), (100.0, 100.0), (1000.0, 10.0)] {
+            let vars = MovementVars {
+                airaccelerate,
+                ..MovementVars::goldsrc(fps)
+            };
+            let table = RadiusSpeedTable::new(&vars);
+            for radius in [60.0, 150.0, 400.0, 1000.0, 3000.0] {
+                match (table.speed_for(radius), speed_for_radius(&vars, radius)) {
+                    (Some(ours), Ok(theirs)) => assert!(
+                        (ours - theirs).abs() < 0.002 * theirs,
+                        "{fps} fps, aa {airaccelerate}, r {radius}: {ours} against {theirs}"
+                    ),
+                    // Both agree that no speed up to sv_maxvelocity turns that wide.
+                    (None, Err(_)) => {}
+                    (ours, theirs) => {
+                        panic!("{fps} fps, aa {airaccelerate}, r {radius}: {ours:?} {theirs:?}")
+                    }
+                }
+            }
+            // Beyond the radius of sv_maxvelocity nothing limits the speed.
+            let widest = measured_radius(&vars, vars.maxvelocity);
+            assert_eq!(table.speed_for(1.01 * widest), None);
+        }
+    }
 
     #[test]
     fn the_turn_arc_is_the_bend_arc_at_90_degrees_and_the_width_for_a_u_turn() {

@@ -4,10 +4,10 @@
 use super::{Controller, RunSummary, Simulation, Trace};
 use crate::budget::Budget;
 use crate::physics::strafe::{
-    max_accel_control, max_accel_cos_theta, max_decel, speed_preserving_cos_theta, strafe_keys,
-    strafe_wish, turning_cos_theta,
+    max_accel_control, max_accel_cos_theta, max_decel, mu_at, speed_preserving_cos_theta,
+    strafe_keys, strafe_wish, turning_cos_theta,
 };
-use crate::physics::{Control, Effect, PlayerState, Side, Vec2, Wish};
+use crate::physics::{AccelLaw, Control, Effect, PlayerState, Side, Vec2, Wish};
 
 /// The keys a controller holds for a scene: full sidemove, jump held when the scene jumps (autojump).
 fn scene_keys(sim: &Simulation) -> Wish {
@@ -289,6 +289,20 @@ impl Greedy {
         cap: Option<f64>,
     ) -> Control {
         match cap {
+            Some(cap) if s.speed() >= cap && self.sharp_turns => {
+                // Above its speed limit and turning as its target needs: the frame whose velocity comes
+                // nearest the limit's speed turned by the pursuit's turn.
+                let wanted_rad = pursuit_turn_rad(s.vel, to_target, sim.scene().frame_time_s())
+                    .min(std::f64::consts::FRAC_PI_2);
+                Control::from_wish(&strafe_wish(
+                    sim.stepper(),
+                    s,
+                    keys,
+                    side,
+                    to_target.angle(),
+                    |lambda, law| nearest_velocity_cos_theta(lambda, law, cap, wanted_rad),
+                ))
+            }
             Some(cap) if s.speed() >= cap => {
                 let before = s.speed();
                 Control::from_wish(&strafe_wish(
@@ -342,6 +356,38 @@ fn pursuit_turn_rad(vel: Vec2, to_target: Vec2, tau_s: f64) -> f64 {
     }
     let sin_alpha = vel.cross(to_target).abs() / (speed * d);
     2.0 * sin_alpha / d * speed * tau_s
+}
+
+/// Strafe angles tried by [`nearest_velocity_cos_theta`] in each of its two grids.
+const NEAREST_VELOCITY_ANGLES: usize = 64;
+
+/// The strafe angle, as `cos theta`, whose velocity after the frame comes nearest the velocity of
+/// `speed_ups` turned by `turn_rad` from the velocity before (of speed `lambda`), docs/physics.md
+/// sections 6 and 7 giving the new speed and its turn at each angle. The angles tried: even steps of
+/// `theta` from 0 to 180 degrees, and even steps of `cos theta` across the law's kink, from
+/// `(L - 2 gamma1) / lambda` to `L / lambda`, where `mu` goes from `gamma1` to nothing within a degree
+/// or less at speed.
+fn nearest_velocity_cos_theta(lambda: f64, law: AccelLaw, speed_ups: f64, turn_rad: f64) -> f64 {
+    // In the frame of the velocity before: after the frame it is `(lambda + mu cos theta, mu sin theta)`.
+    let wanted = Vec2::new(turn_rad.cos(), turn_rad.sin()) * speed_ups;
+    let miss = |c: f64| {
+        let mu = mu_at(lambda, c, law);
+        let sin = (1.0 - c * c).max(0.0).sqrt();
+        (Vec2::new(lambda + mu * c, mu * sin) - wanted).length_squared()
+    };
+    let steps = NEAREST_VELOCITY_ANGLES as f64;
+    let even_theta =
+        (0..=NEAREST_VELOCITY_ANGLES).map(|k| (std::f64::consts::PI * k as f64 / steps).cos());
+    let (lo, hi) = (
+        ((law.l - 2.0 * law.gamma1) / lambda).clamp(-1.0, 1.0),
+        (law.l / lambda).clamp(-1.0, 1.0),
+    );
+    let across_kink = (0..=NEAREST_VELOCITY_ANGLES).map(|k| lo + (hi - lo) * k as f64 / steps);
+    even_theta
+        .chain(across_kink)
+        .map(|c| (miss(c), c))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(1.0, |(_, c)| c)
 }
 
 /// How often the greedy strafer halves its look-ahead looking for a target in plain sight.
@@ -465,6 +511,29 @@ fn best_of_sweep(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::physics::strafe::{speed_after, turn_at};
+
+    #[test]
+    fn the_nearest_velocity_brakes_straight_back_or_turns_as_asked() {
+        // 100 fps, air acceleration 10: L = 30, gamma1 = 32 ups a frame, at 1000 ups.
+        let vars = crate::physics::MovementVars::goldsrc(100.0);
+        let law = crate::physics::curvature::air_law(&vars);
+        let lambda = 1000.0;
+        // Down by gamma1 with no turn: straight back, the frame's whole braking.
+        let back = nearest_velocity_cos_theta(lambda, law, lambda - law.gamma1, 0.0);
+        assert_eq!(back, -1.0);
+        // Held speed, turned by two thirds of the sharpest speed-holding turn: the angle among the grid's
+        // that comes nearest, and it turns that way within a grid step's turn.
+        let sharpest = 2.0 * (0.5 * law.gamma1 / lambda).asin();
+        let asked = 2.0 * sharpest / 3.0;
+        let c = nearest_velocity_cos_theta(lambda, law, lambda, asked);
+        let turned = turn_at(lambda, c, law);
+        assert!(
+            (turned - asked).abs() < 0.1 * asked,
+            "{turned} against {asked}"
+        );
+        assert!((speed_after(lambda, c, law) - lambda).abs() < 0.1 * law.gamma1);
+    }
 
     #[test]
     fn pursuit_turns_onto_the_arc_through_the_target() {
