@@ -210,76 +210,15 @@ fn too_close(corridor: &Corridor, points: &[Vec2], min_units: f64) -> Vec<usize>
 }
 
 /// The offsets `alpha` within `bounds` that minimise `sum |D_i|^2`, `D_i = p_(i-1) - 2 p_i + p_(i+1)`
-/// with `p_i = c_i + alpha_i n_i`: a convex quadratic programme for Clarabel (`1/2 x'Px + q'x` with
-/// `P = 2 sum J_i'J_i`, `q = 2 sum J_i'd_i`, where `J_i` holds `n_(i-1), -2 n_i, n_(i+1)` and `d_i` is
-/// the centre line's own second difference).
+/// with `p_i = c_i + alpha_i n_i`: a convex quadratic programme ([`bending_objective`],
+/// [`offset_constraints`]) that Clarabel solves.
 fn least_bending_offsets(
     centre: &[Vec2],
     normals: &[Vec2],
     bounds: &[(f64, f64)],
 ) -> Option<Vec<f64>> {
-    let n = centre.len();
-    let mut dense_bands = vec![[0.0; 3]; n];
-    let mut q = vec![0.0; n];
-    for i in 1..n - 1 {
-        let d = centre[i - 1] - centre[i] * 2.0 + centre[i + 1];
-        let cols = [
-            (i - 1, normals[i - 1]),
-            (i, normals[i] * -2.0),
-            (i + 1, normals[i + 1]),
-        ];
-        for &(a, ja) in &cols {
-            q[a] += 2.0 * ja.dot(d);
-            for &(b, jb) in &cols {
-                if b >= a {
-                    dense_bands[a][b - a] += 2.0 * ja.dot(jb);
-                }
-            }
-        }
-    }
-    let (mut pr, mut pc, mut pv) = (Vec::new(), Vec::new(), Vec::new());
-    for (a, band) in dense_bands.iter().enumerate() {
-        for (k, &v) in band.iter().enumerate() {
-            if a + k < n && v != 0.0 {
-                pr.push(a);
-                pc.push(a + k);
-                pv.push(v);
-            }
-        }
-    }
-    let p = CscMatrix::new_from_triplets(n, n, pr, pc, pv);
-    // Rows: the fixed offsets (zero cone), then alpha <= hi and -alpha <= -lo (nonnegative cone).
-    let fixed: Vec<usize> = (0..n)
-        .filter(|&i| bounds[i].1 - bounds[i].0 <= 0.0)
-        .collect();
-    let free: Vec<usize> = (0..n)
-        .filter(|&i| bounds[i].1 - bounds[i].0 > 0.0)
-        .collect();
-    let (mut ar, mut ac, mut av, mut b) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for &i in &fixed {
-        ar.push(b.len());
-        ac.push(i);
-        av.push(1.0);
-        b.push(0.5 * (bounds[i].0 + bounds[i].1));
-    }
-    for &i in &free {
-        ar.push(b.len());
-        ac.push(i);
-        av.push(1.0);
-        b.push(bounds[i].1);
-        ar.push(b.len());
-        ac.push(i);
-        av.push(-1.0);
-        b.push(-bounds[i].0);
-    }
-    let a = CscMatrix::new_from_triplets(b.len(), n, ar, ac, av);
-    let mut cones: Vec<SupportedConeT<f64>> = Vec::new();
-    if !fixed.is_empty() {
-        cones.push(ZeroConeT(fixed.len()));
-    }
-    if !free.is_empty() {
-        cones.push(NonnegativeConeT(2 * free.len()));
-    }
+    let (p, q) = bending_objective(centre, normals);
+    let (a, b, cones, fixed) = offset_constraints(bounds);
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
         .max_iter(200)
@@ -297,6 +236,89 @@ fn least_bending_offsets(
         x[i] = 0.5 * (bounds[i].0 + bounds[i].1);
     }
     x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// The bending as Clarabel's objective `1/2 x'Px + q'x` in the offsets: `P = 2 sum J_i'J_i`,
+/// `q = 2 sum J_i'd_i`, where `J_i` holds `n_(i-1), -2 n_i, n_(i+1)` in the columns of its three points
+/// and `d_i` is the centre line's own second difference. `P` is banded: its upper triangle is three
+/// diagonals.
+fn bending_objective(centre: &[Vec2], normals: &[Vec2]) -> (CscMatrix<f64>, Vec<f64>) {
+    let n = centre.len();
+    let mut upper_diagonals = vec![[0.0; 3]; n];
+    let mut q = vec![0.0; n];
+    for i in 1..n.saturating_sub(1) {
+        let d = centre[i - 1] - centre[i] * 2.0 + centre[i + 1];
+        let cols = [
+            (i - 1, normals[i - 1]),
+            (i, normals[i] * -2.0),
+            (i + 1, normals[i + 1]),
+        ];
+        for &(a, ja) in &cols {
+            q[a] += 2.0 * ja.dot(d);
+            for &(b, jb) in &cols {
+                if b >= a {
+                    upper_diagonals[a][b - a] += 2.0 * ja.dot(jb);
+                }
+            }
+        }
+    }
+    let (mut pr, mut pc, mut pv) = (Vec::new(), Vec::new(), Vec::new());
+    for (a, diagonals) in upper_diagonals.iter().enumerate() {
+        for (k, &v) in diagonals.iter().enumerate() {
+            // Entries no term reached stay out of the sparse matrix (a structural zero is exactly 0).
+            if a + k < n && v != 0.0 {
+                pr.push(a);
+                pc.push(a + k);
+                pv.push(v);
+            }
+        }
+    }
+    (CscMatrix::new_from_triplets(n, n, pr, pc, pv), q)
+}
+
+/// Clarabel's constraints `Ax + s = b` (`A`, `b` and the cones of the rows), and the indices of the
+/// offsets they fix.
+type Constraints = (
+    CscMatrix<f64>,
+    Vec<f64>,
+    Vec<SupportedConeT<f64>>,
+    Vec<usize>,
+);
+
+/// The offsets' bounds as constraints: the offsets fixed (no room: the start, or a point with no
+/// stretch off the walls) in a zero cone, then `alpha <= hi` and `-alpha <= -lo` in a nonnegative cone.
+fn offset_constraints(bounds: &[(f64, f64)]) -> Constraints {
+    let n = bounds.len();
+    let fixed: Vec<usize> = (0..n)
+        .filter(|&i| bounds[i].1 - bounds[i].0 <= 0.0)
+        .collect();
+    let free: Vec<usize> = (0..n)
+        .filter(|&i| bounds[i].1 - bounds[i].0 > 0.0)
+        .collect();
+    let (mut ar, mut ac, mut av, mut b) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for &i in &fixed {
+        ar.push(b.len());
+        ac.push(i);
+        av.push(1.0);
+        b.push(0.5 * (bounds[i].0 + bounds[i].1));
+    }
+    for &i in &free {
+        for (sign, limit) in [(1.0, bounds[i].1), (-1.0, -bounds[i].0)] {
+            ar.push(b.len());
+            ac.push(i);
+            av.push(sign);
+            b.push(limit);
+        }
+    }
+    let a = CscMatrix::new_from_triplets(b.len(), n, ar, ac, av);
+    let mut cones: Vec<SupportedConeT<f64>> = Vec::new();
+    if !fixed.is_empty() {
+        cones.push(ZeroConeT(fixed.len()));
+    }
+    if !free.is_empty() {
+        cones.push(NonnegativeConeT(2 * free.len()));
+    }
+    (a, b, cones, fixed)
 }
 
 #[cfg(test)]
