@@ -247,10 +247,22 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
         (scan_best.0 + step).min(std::f64::consts::PI),
     );
     let g = 0.5 * (5f64.sqrt() - 1.0);
+    // The turns of the last iteration's two angles: a new angle is one of them to the bit about three
+    // times in ten (in exact arithmetic every iteration would reuse one), and is then not worked out
+    // again.
+    let mut known = [(f64::NAN, 0.0); 2];
+    let turn_known = |x: f64, known: &[(f64, f64); 2]| {
+        known
+            .iter()
+            .find(|k| k.0.to_bits() == x.to_bits())
+            .map_or_else(|| turn(x), |k| k.1)
+    };
     for _ in 0..80 {
         let x1 = b - g * (b - a);
         let x2 = a + g * (b - a);
-        if turn(x1) >= turn(x2) {
+        let (t1, t2) = (turn_known(x1, &known), turn_known(x2, &known));
+        known = [(x1, t1), (x2, t2)];
+        if t1 >= t2 {
             b = x2;
         } else {
             a = x1;
