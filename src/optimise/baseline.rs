@@ -336,7 +336,8 @@ enum Cornering {
 
 /// The guide paths of `scene`: the shortest path (the lower bound's) and the paths kept each of
 /// [`GUIDE_CLEARANCES_UNITS`] off the walls where the corridor has room, then the centre line.
-fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
+fn guide_paths(sim: &Simulation, bound: &LowerBound) -> Vec<GuidePath> {
+    let scene = sim.scene();
     let mut guides = vec![GuidePath {
         clearance_units: 0.0,
         centre_line: false,
@@ -368,7 +369,7 @@ fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
         }
     }
     if scene.effects.is_air_only() {
-        let lines = racing_lines(scene, &guides[guides.len() - 1]);
+        let lines = racing_lines(sim.corridor(), &guides[guides.len() - 1]);
         guides.extend(lines);
     }
     guides
@@ -376,15 +377,12 @@ fn guide_paths(scene: &Scene, bound: &LowerBound) -> Vec<GuidePath> {
 
 /// The racing lines ([`RacingLine`]) along the widest guide `widest`, one at each of
 /// [`RACING_LINE_MARGINS_UNITS`] it has room for.
-fn racing_lines(scene: &Scene, widest: &GuidePath) -> Vec<GuidePath> {
-    let Ok(corridor) = Corridor::new(&scene.walls) else {
-        return Vec::new();
-    };
+fn racing_lines(corridor: &Corridor, widest: &GuidePath) -> Vec<GuidePath> {
     RACING_LINE_MARGINS_UNITS
         .iter()
         .filter(|&&m| m <= widest.clearance_units)
         .filter_map(|&m| {
-            let line = RacingLine::through(&corridor, &widest.path, m)?;
+            let line = RacingLine::through(corridor, &widest.path, m)?;
             Some(GuidePath {
                 clearance_units: m,
                 centre_line: false,
@@ -432,7 +430,7 @@ pub(super) fn baseline(
     bound: &LowerBound,
     budget: &Budget,
 ) -> Baseline {
-    let guides = guide_paths(scene, bound);
+    let guides = guide_paths(sim, bound);
     let fx = scene.effects;
     // Ground movement (groundstrafing, jumping) gets the capped runs only when no uncapped run is valid
     // in both arithmetics: maximum acceleration overshoots a sharp corner of a narrow corridor, and along
@@ -791,8 +789,8 @@ mod tests {
     #[test]
     fn a_racing_line_keeps_only_its_binding_points_and_limits_the_same() {
         let scene = narrow_scene(3);
-        let (_, bound, _) = planning_inputs(&scene);
-        let guides = guide_paths(&scene, &bound);
+        let (sim, bound, _) = planning_inputs(&scene);
+        let guides = guide_paths(&sim, &bound);
         let line = guides
             .iter()
             .find(|g| g.racing_line)
@@ -911,10 +909,9 @@ mod tests {
         assert!((speeds.braking_ups_per_s - gamma1 * 100.0).abs() < 1e-9);
     }
 
-    /// The fastest valid run of the strafer along every guide of `scene` taking corners each of the ways
-    /// of `cornering` (and plain first if `plain`): its crossing time, seconds, and its guide.
+    /// The fastest valid run of the strafer along every guide of `sim`'s scene taking corners each of the
+    /// ways of `cornering` (and plain first if `plain`): its crossing time, seconds, and its guide.
     fn fastest_valid(
-        scene: &Scene,
         sim: &Simulation,
         bound: &LowerBound,
         cornering: &[Cornering],
@@ -922,7 +919,7 @@ mod tests {
     ) -> (f64, GreedyGuide) {
         let mut runs = GuideRuns::default();
         let limit = given_up_frame(bound);
-        let guides = guide_paths(scene, bound);
+        let guides = guide_paths(sim, bound);
         let budget = Budget::unlimited();
         sweep_guides(sim, &guides, cornering, plain, limit, &budget, &mut runs);
         let (t, _, guide) = runs.valid[0];
@@ -949,7 +946,7 @@ mod tests {
             .fold(f64::INFINITY, f64::min);
         // The best valid run of every other strafer.
         let others: Vec<Cornering> = speed_limits(&scene, &bound.path).collect();
-        let (other_s, other) = fastest_valid(&scene, &sim, &bound, &others, true);
+        let (other_s, other) = fastest_valid(&sim, &bound, &others, true);
         // Measured: 200 frames, never under 1073 ups; the best other run 2.65 s (corner speeds).
         assert!(slowest > 800.0, "{slowest} ups through the hairpin");
         assert!(
@@ -967,10 +964,10 @@ mod tests {
             .iter()
             .map(|&w| Cornering::CornerSpeeds(w))
             .collect();
-        let (best_s, guide) = fastest_valid(&scene, &sim, &bound, &corner_speeds, false);
+        let (best_s, guide) = fastest_valid(&sim, &bound, &corner_speeds, false);
         assert!(guide.corner_bend_units.is_some(), "{guide}");
         let frames = (best_s / scene.frame_time_s()).ceil() as u64;
-        let shortest = &guide_paths(&scene, &bound)[0].path;
+        let shortest = &guide_paths(&sim, &bound)[0].path;
         let mut capped = u64::MAX;
         for cap in corner_caps(&scene, &bound.path) {
             for &la in &GREEDY_LOOKAHEADS_UNITS {
