@@ -537,14 +537,29 @@ fn strafer(path: &[Vec2], guide: &GreedyGuide, corners: Option<&CornerSpeeds>) -
 
 /// The strafer of `guide` along `path`, its corner speeds worked out for it.
 fn strafer_of(sim: &Simulation, path: &[Vec2], guide: &GreedyGuide) -> Greedy {
-    let corners = if let Some(share) = guide.racing_line {
-        Some(curvature_speeds(sim.scene(), path, share))
-    } else {
-        guide
-            .corner_bend_units
-            .map(|w| corner_speeds(sim.scene(), path, w))
-    };
+    let corners = speeds_along(
+        sim.scene(),
+        path,
+        guide.corner_bend_units,
+        guide.racing_line,
+    );
     strafer(path, guide, corners.as_ref())
+}
+
+/// The speeds a strafer keeps under along `path`: a racing line's at the share `racing_line` of its
+/// radii ([`curvature_speeds`]), else the corner speeds of bends `corner_bend_units` wide
+/// ([`corner_speeds`]), else none. The same at every look-ahead.
+fn speeds_along(
+    scene: &Scene,
+    path: &[Vec2],
+    corner_bend_units: Option<f64>,
+    racing_line: Option<f64>,
+) -> Option<CornerSpeeds> {
+    match (racing_line, corner_bend_units) {
+        (Some(share), _) => Some(curvature_speeds(scene, path, share)),
+        (None, Some(w)) => Some(corner_speeds(scene, path, w)),
+        (None, None) => None,
+    }
 }
 
 /// Run `i`'s guide played again whole.
@@ -640,11 +655,7 @@ fn sweep_guide(
         Some(Cornering::Curvature(share)) => (None, None, true, Some(share)),
     };
     let g = &guides[i];
-    // The corner speeds along this guide, the same at every look-ahead.
-    let corners = match racing_line {
-        Some(share) => Some(curvature_speeds(sim.scene(), &g.path, share)),
-        None => corner_bend_units.map(|w| corner_speeds(sim.scene(), &g.path, w)),
-    };
+    let corners = speeds_along(sim.scene(), &g.path, corner_bend_units, racing_line);
     let mut swept = GuideSweep {
         clean: None,
         valid: None,

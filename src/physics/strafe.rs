@@ -199,16 +199,16 @@ pub fn speed_preserving_cos_theta(speed_before: f64, lambda: f64, law: AccelLaw)
 /// Steps of [`sharpest_turn`]'s scan over `theta` from 0 to pi.
 const SHARPEST_TURN_SCAN: usize = 256;
 
+/// The step of [`sharpest_turn`]'s scan, radians.
+const SHARPEST_TURN_STEP_RAD: f64 = std::f64::consts::PI / SHARPEST_TURN_SCAN as f64;
+
 /// `(sin theta, cos theta)` at each angle of [`sharpest_turn`]'s scan, worked out once: the greedy
 /// strafer turning sharply asks for the sharpest turn nearly every frame, and these sines and cosines were a
 /// fifth of the greedy sweep's time.
 fn sharpest_turn_scan() -> &'static [(f64, f64); SHARPEST_TURN_SCAN + 1] {
     static SCAN: std::sync::OnceLock<[(f64, f64); SHARPEST_TURN_SCAN + 1]> =
         std::sync::OnceLock::new();
-    SCAN.get_or_init(|| {
-        let step = std::f64::consts::PI / SHARPEST_TURN_SCAN as f64;
-        std::array::from_fn(|i| (i as f64 * step).sin_cos())
-    })
+    SCAN.get_or_init(|| std::array::from_fn(|i| (i as f64 * SHARPEST_TURN_STEP_RAD).sin_cos()))
 }
 
 /// The sharpest turn of one frame (docs/physics.md section 9): the `theta` in `[0, pi]` that turns the velocity
@@ -234,7 +234,7 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
         consider(theta_from_cos(-law.gamma1 / lambda), &mut best);
     }
     // A scan over theta refined around its best sample (golden section on the bracketing interval).
-    let step = std::f64::consts::PI / SHARPEST_TURN_SCAN as f64;
+    let step = SHARPEST_TURN_STEP_RAD;
     let mut scan_best = (0.0, f64::NEG_INFINITY);
     for (i, &(s, c)) in sharpest_turn_scan().iter().enumerate() {
         let t = turn_of(lambda, c, s, law);
