@@ -196,30 +196,42 @@ pub fn speed_preserving_cos_theta(speed_before: f64, lambda: f64, law: AccelLaw)
         })
 }
 
-/// Steps of [`sharpest_turn`]'s scan over `theta` from 0 to pi.
+/// Steps of [`sharpest_turn`]'s scan over `theta` from 0 to pi, for the laws its closed form leaves open.
 const SHARPEST_TURN_SCAN: usize = 256;
 
-/// The step of [`sharpest_turn`]'s scan, radians.
-const SHARPEST_TURN_STEP_RAD: f64 = std::f64::consts::PI / SHARPEST_TURN_SCAN as f64;
+/// Golden-section iterations refining [`sharpest_turn`]'s scan.
+const SHARPEST_TURN_GOLDEN_STEPS: usize = 80;
 
-/// `(sin theta, cos theta)` at each angle of [`sharpest_turn`]'s scan, worked out once: the greedy
-/// strafer turning sharply asks for the sharpest turn nearly every frame, and these sines and cosines were a
-/// fifth of the greedy sweep's time.
-fn sharpest_turn_scan() -> &'static [(f64, f64); SHARPEST_TURN_SCAN + 1] {
-    static SCAN: std::sync::OnceLock<[(f64, f64); SHARPEST_TURN_SCAN + 1]> =
-        std::sync::OnceLock::new();
-    SCAN.get_or_init(|| std::array::from_fn(|i| (i as f64 * SHARPEST_TURN_STEP_RAD).sin_cos()))
-}
-
-/// The sharpest turn of one frame (docs/physics.md section 9): the `theta` in `[0, pi]` that turns the velocity
-/// furthest, and that turn, radians. The turn at `theta` is `atan2(mu sin theta, lambda + mu cos theta)`.
-/// Where `mu = gamma1` it peaks at `cos theta = -gamma1/lambda`; where `mu = gamma2` it is found by a scan
+/// The sharpest turn of one frame (docs/physics.md section 9): the `theta` in `[0, pi]` that turns the
+/// velocity furthest, and that turn, radians. The turn at `theta` is `atan2(mu sin theta, lambda + mu cos
+/// theta)`.
+///
+/// With `gamma1 > 0` and `L >= 0` (every law of a real engine) it is the peak of the `mu = gamma1` piece,
+/// `cos theta = max(-gamma1 / lambda, -1)` (`theta = pi` at rest):
+/// - On the `mu = gamma1` piece (`lambda cos theta <= L - gamma1`) the new velocity is `lambda` plus
+///   `gamma1` along the wish direction; its turn grows with `theta` while `gamma1 + lambda cos theta > 0`
+///   and falls after, so it peaks at `cos theta = -gamma1 / lambda`, which lies on this piece as `L >= 0`.
+/// - On the `mu = L - lambda cos theta` piece the new velocity is `lambda` projected onto the line
+///   `x . a_hat = L`, turned by `theta - atan(lambda sin theta / L)`, whose derivative in `theta` has the
+///   sign of `L^2 + lambda^2 sin^2 theta - lambda L cos theta`, never negative where `mu > 0`: the turn
+///   grows towards the kink and joins the first piece there.
+/// - Where `mu = 0` the velocity does not turn.
+///
+/// For other laws (negative gains, `L < 0`) the piece boundaries are compared with a scan over `theta`
 /// refined by golden-section search.
 pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
     let turn = |theta: f64| {
         let (s, c) = theta.sin_cos();
         turn_of(lambda, c, s, law)
     };
+    if law.gamma1 > 0.0 && law.l >= 0.0 && lambda >= 0.0 {
+        let theta = if lambda > 0.0 {
+            theta_from_cos(-law.gamma1 / lambda)
+        } else {
+            std::f64::consts::PI
+        };
+        return (theta, turn(theta));
+    }
     let mut best = (0.0, turn(0.0));
     let consider = |theta: f64, best: &mut (f64, f64)| {
         let t = turn(theta);
@@ -234,12 +246,13 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
         consider(theta_from_cos(-law.gamma1 / lambda), &mut best);
     }
     // A scan over theta refined around its best sample (golden section on the bracketing interval).
-    let step = SHARPEST_TURN_STEP_RAD;
+    let step = std::f64::consts::PI / SHARPEST_TURN_SCAN as f64;
     let mut scan_best = (0.0, f64::NEG_INFINITY);
-    for (i, &(s, c)) in sharpest_turn_scan().iter().enumerate() {
-        let t = turn_of(lambda, c, s, law);
+    for i in 0..=SHARPEST_TURN_SCAN {
+        let theta = i as f64 * step;
+        let t = turn(theta);
         if t > scan_best.1 {
-            scan_best = (i as f64 * step, t);
+            scan_best = (theta, t);
         }
     }
     let (mut a, mut b) = (
@@ -247,22 +260,10 @@ pub fn sharpest_turn(lambda: f64, law: AccelLaw) -> (f64, f64) {
         (scan_best.0 + step).min(std::f64::consts::PI),
     );
     let g = 0.5 * (5f64.sqrt() - 1.0);
-    // The turns of the last iteration's two angles: a new angle is one of them to the bit about three
-    // times in ten (in exact arithmetic every iteration would reuse one), and is then not worked out
-    // again.
-    let mut known = [(f64::NAN, 0.0); 2];
-    let turn_known = |x: f64, known: &[(f64, f64); 2]| {
-        known
-            .iter()
-            .find(|k| k.0.to_bits() == x.to_bits())
-            .map_or_else(|| turn(x), |k| k.1)
-    };
-    for _ in 0..80 {
+    for _ in 0..SHARPEST_TURN_GOLDEN_STEPS {
         let x1 = b - g * (b - a);
         let x2 = a + g * (b - a);
-        let (t1, t2) = (turn_known(x1, &known), turn_known(x2, &known));
-        known = [(x1, t1), (x2, t2)];
-        if t1 >= t2 {
+        if turn(x1) >= turn(x2) {
             b = x2;
         } else {
             a = x1;
@@ -433,6 +434,56 @@ mod tests {
 
     fn law(l: f64, gamma1: f64) -> AccelLaw {
         AccelLaw { l, gamma1 }
+    }
+
+    #[test]
+    fn the_sharpest_turn_of_a_law_its_closed_form_leaves_open_is_refined_to_its_peak() {
+        // L < 0 or negative gains: the scan and its golden section decide. No angle within a
+        // thousandth of a radian of theirs may turn further (a refinement cut short leaves its answer
+        // up to a scan step off the peak).
+        let turn = |lam: f64, theta: f64, law: AccelLaw| {
+            let (s, c) = theta.sin_cos();
+            turn_of(lam, c, s, law)
+        };
+        for &(l, g) in &[
+            (-5.0, 3.2),
+            (-20.0, 32.0),
+            (-50.0, 320.0),
+            (30.0, -3.2),
+            (-5.0, -32.0),
+        ] {
+            for &lam in &[10.0, 100.0, 700.0, 2000.0] {
+                let law = law(l, g);
+                let (theta, best) = sharpest_turn(lam, law);
+                assert!((turn(lam, theta, law) - best).abs() < 1e-15);
+                for i in -1000..=1000 {
+                    let other = (theta + f64::from(i) * 1e-6).clamp(0.0, std::f64::consts::PI);
+                    let t = turn(lam, other, law);
+                    assert!(
+                        t <= best + 1e-13,
+                        "L {l}, gamma1 {g}, lambda {lam}: {other} turns {t} > {best}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_sharpest_turn_of_an_engine_law_is_its_closed_form() {
+        // gamma1 < lambda: the peak of the mu = gamma1 piece, asin(gamma1 / lambda); else half a turn.
+        for &(lam, l, g) in &[
+            (700.0, 30.0, 3.2),
+            (700.0, 30.0, 32.0),
+            (1200.0, 30.0, 320.0),
+            (320.0, 320.0, 32.0),
+        ] {
+            let (theta, turn) = sharpest_turn(lam, law(l, g));
+            assert!((theta.cos() + g / lam).abs() < 1e-12, "{lam} {l} {g}");
+            assert!((turn - (g / lam).asin()).abs() < 1e-12, "{lam} {l} {g}");
+        }
+        let (theta, turn) = sharpest_turn(100.0, law(30.0, 320.0));
+        assert_eq!(theta, std::f64::consts::PI);
+        assert!((turn - std::f64::consts::PI).abs() < 1e-12);
     }
 
     #[test]
