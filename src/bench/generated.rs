@@ -77,6 +77,10 @@ pub struct SceneRecord {
     pub replays: u64,
     /// See [`SceneRecord::replays`].
     pub valid_replays: u64,
+    /// The share of the solve's sub-problems the frame-by-frame solver gave no solution for, handed to
+    /// Clarabel, percent (`solve`'s `stats.handed_to_clarabel` over `stats.subproblems`); `None` where
+    /// there were none.
+    pub handed_to_clarabel_pct: Option<f64>,
     /// The greedy guide that gave the baseline.
     pub greedy_guide: String,
     /// `solve`'s status and the plan's source, or the error.
@@ -118,6 +122,7 @@ impl SceneRecord {
             relaxed_frame_left: None,
             replays: 0,
             valid_replays: 0,
+            handed_to_clarabel_pct: None,
             greedy_guide: String::new(),
             status: String::new(),
         }
@@ -174,6 +179,8 @@ pub fn measure_generated_scene(g: &GeneratedScene, settings: &SearchSettings) ->
     r.stage_seconds = Some(out.stage_seconds);
     r.replays = out.stats.replays;
     r.valid_replays = out.stats.valid_replays;
+    r.handed_to_clarabel_pct = (out.stats.subproblems > 0)
+        .then(|| 100.0 * out.stats.handed_to_clarabel as f64 / out.stats.subproblems as f64);
     r.greedy_guide = out.greedy_guide.to_string();
     if let Some(c) = out.relaxed {
         r.relaxed_frames = Some(c.frames);
@@ -260,6 +267,10 @@ pub fn columns() -> Vec<Column> {
         Column {
             name: "solve time (s)",
             value: |r| Some(r.solve_seconds),
+        },
+        Column {
+            name: "sub-problems handed to Clarabel (%)",
+            value: |r| r.handed_to_clarabel_pct,
         },
         Column {
             name: "share in the baseline (%)",
@@ -424,6 +435,7 @@ mod tests {
             relaxed_frame_left: None,
             replays: 0,
             valid_replays: 0,
+            handed_to_clarabel_pct: None,
             greedy_guide: String::new(),
             status: String::new(),
         }

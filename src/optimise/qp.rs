@@ -138,6 +138,9 @@ pub struct SubStep {
     /// Interior-point iterations of the solve that gave the step (a failed attempt's before it not
     /// counted); 0 when failed.
     pub iterations: u32,
+    /// Whether the frame-by-frame solver was asked first and gave no solution, so that Clarabel was
+    /// asked (about three times dearer).
+    pub handed_to_clarabel: bool,
 }
 
 /// A control's allowed change at most this wide (scaled units) counts as none: the control is fixed.
@@ -160,6 +163,7 @@ impl SubStep {
             dynamics_duals: vec![],
             warm_start: None,
             iterations: 0,
+            handed_to_clarabel: false,
         }
     }
 }
@@ -243,8 +247,9 @@ fn solve_limited(
             ..step
         };
     }
+    let handed_to_clarabel = sp.solver == SubProblemSolver::Riccati;
     let left_s = time_limit_s - started.elapsed().as_secs_f64();
-    match clarabel_solved(sp, &layout, &rhs, max_iterations, left_s) {
+    let step = match clarabel_solved(sp, &layout, &rhs, max_iterations, left_s) {
         Ok(solution) if solution.x.len() == layout.n_vars() => {
             // Clarabel's duals begin with those of the dynamics rows, four a frame.
             let z = &solution.z;
@@ -262,6 +267,10 @@ fn solve_limited(
         }
         Ok(_) => SubStep::failed(SubStepStatus::Failed("solution of the wrong size".into())),
         Err(no) => SubStep::failed(SubStepStatus::Failed(no.to_string())),
+    };
+    SubStep {
+        handed_to_clarabel,
+        ..step
     }
 }
 
@@ -550,6 +559,7 @@ fn sub_step_of(
         dynamics_duals,
         warm_start: None,
         iterations,
+        handed_to_clarabel: false,
     }
 }
 
@@ -1198,6 +1208,35 @@ mod tests {
             assert_eq!(retried.iterations, cold.iterations, "case {case}");
             assert_eq!(retried.du, cold.du, "case {case}");
         }
+    }
+
+    #[test]
+    fn only_a_sub_problem_the_frame_by_frame_solver_cannot_take_is_counted_as_handed_to_clarabel() {
+        let mut s = Stream(20261202);
+        let mut chain = random_chain(&mut s);
+        let [riccati, clarabel] = by_each_solver(&chain.sub_problem());
+        assert_eq!(riccati.status, SubStepStatus::Solved { almost: false });
+        assert!(!riccati.handed_to_clarabel);
+        // Asked for Clarabel, it is not handed on: it is where it was sent.
+        assert!(!clarabel.handed_to_clarabel);
+        // Two slacks ending at the last frame: not a chain of frames, so Clarabel solves it.
+        let last = chain.jacobians.len() - 1;
+        let plane = HalfPlane {
+            normal: Vec2::new(0.0, 1.0),
+            offset: -100.0,
+        };
+        for group in [1000, 1001] {
+            chain.walls.push(WallRow {
+                frame: last,
+                plane,
+                group,
+            });
+        }
+        let [handed, asked] = by_each_solver(&chain.sub_problem());
+        assert_eq!(handed.status, SubStepStatus::Solved { almost: false });
+        assert!(handed.handed_to_clarabel);
+        assert!(!asked.handed_to_clarabel);
+        assert_eq!(handed.du, asked.du);
     }
 
     #[test]

@@ -696,6 +696,7 @@ impl ScpSolver<'_> {
         }
         self.stats.subproblems += 1;
         self.stats.interior_point_iterations += u64::from(step.iterations);
+        self.stats.handed_to_clarabel += u64::from(step.handed_to_clarabel);
         if !matches!(step.status, SubStepStatus::Solved { .. }) {
             self.stats.subproblem_failures += 1;
         }

@@ -242,6 +242,10 @@ pub struct SearchStats {
     pub subproblem_failures: u64,
     /// Interior-point iterations of the solved sub-problems, by either solver.
     pub interior_point_iterations: u64,
+    /// Sub-problems the frame-by-frame solver gave no solution for (a frame's reduced Hessian not
+    /// positive definite where an active wall row meets an active bound, its iteration cap, or rows not
+    /// a chain), each then given to Clarabel, about three times dearer.
+    pub handed_to_clarabel: u64,
     /// Steps rejected by exact re-simulation, their second-order correction too.
     pub rejected_steps: u64,
     /// Steps rejected by exact re-simulation but kept after a second-order correction (each such
@@ -268,6 +272,7 @@ impl SearchStats {
         self.subproblems += other.subproblems;
         self.subproblem_failures += other.subproblem_failures;
         self.interior_point_iterations += other.interior_point_iterations;
+        self.handed_to_clarabel += other.handed_to_clarabel;
         self.rejected_steps += other.rejected_steps;
         self.corrected_steps += other.corrected_steps;
         self.fed_steps += other.fed_steps;
