@@ -139,7 +139,7 @@ pub struct SubStep {
     /// counted); 0 when failed.
     pub iterations: u32,
     /// Whether the frame-by-frame solver was asked first and gave no solution, so that Clarabel was
-    /// asked (about three times dearer).
+    /// asked.
     pub handed_to_clarabel: bool,
 }
 

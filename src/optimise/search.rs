@@ -244,7 +244,8 @@ pub struct SearchStats {
     pub interior_point_iterations: u64,
     /// Sub-problems the frame-by-frame solver gave no solution for (a frame's reduced Hessian not
     /// positive definite where an active wall row meets an active bound, its iteration cap, or rows not
-    /// a chain), each then given to Clarabel, about three times dearer.
+    /// a chain), each then given to Clarabel. They mark the hard scenes (docs/design.md, "Where
+    /// gen-4848-1's time goes").
     pub handed_to_clarabel: u64,
     /// Steps rejected by exact re-simulation, their second-order correction too.
     pub rejected_steps: u64,
