@@ -314,12 +314,22 @@ fn ground_caps(scene: &Scene, path: &[Vec2]) -> Vec<f64> {
     caps
 }
 
-/// A guide path: the shortest path of a body `clearance_units` wider than the hull on either side.
+/// A guide path, `clearance_units` off the walls beyond the hull's half width.
 struct GuidePath {
     clearance_units: f64,
-    centre_line: bool,
-    racing_line: bool,
+    kind: GuideKind,
     path: Vec<Vec2>,
+}
+
+/// What a guide path is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum GuideKind {
+    /// The shortest path of a body `clearance_units` wider than the hull on either side.
+    Shortest,
+    /// The centre line ([`centre_line`]).
+    CentreLine,
+    /// A racing line ([`RacingLine`]).
+    RacingLine,
 }
 
 /// How a greedy run takes corners its maximum-acceleration turn cannot: keeping its speed down (a speed
@@ -340,16 +350,14 @@ fn guide_paths(sim: &Simulation, bound: &LowerBound) -> Vec<GuidePath> {
     let scene = sim.scene();
     let mut guides = vec![GuidePath {
         clearance_units: 0.0,
-        centre_line: false,
-        racing_line: false,
+        kind: GuideKind::Shortest,
         path: bound.path.clone(),
     }];
     for &extra in &GUIDE_CLEARANCES_UNITS[1..] {
         match clear_path(scene, extra) {
             Some(path) => guides.push(GuidePath {
                 clearance_units: extra,
-                centre_line: false,
-                racing_line: false,
+                kind: GuideKind::Shortest,
                 path,
             }),
             None => break,
@@ -362,8 +370,7 @@ fn guide_paths(sim: &Simulation, bound: &LowerBound) -> Vec<GuidePath> {
         if !known {
             guides.push(GuidePath {
                 clearance_units: extra,
-                centre_line: true,
-                racing_line: false,
+                kind: GuideKind::CentreLine,
                 path,
             });
         }
@@ -385,8 +392,7 @@ fn racing_lines(corridor: &Corridor, widest: &GuidePath) -> Vec<GuidePath> {
             let line = RacingLine::through(corridor, &widest.path, m)?;
             Some(GuidePath {
                 clearance_units: m,
-                centre_line: false,
-                racing_line: true,
+                kind: GuideKind::RacingLine,
                 path: line.points,
             })
         })
@@ -587,7 +593,10 @@ fn sweep_guides(
     // Speed-limited runs along the shortest path and the widest guide only: the limits are for corners
     // the uncapped strafer overshoots, and every guide in between would multiply the runs. Sharp turns
     // keep the speed, so the guide they follow matters as much as the plain strafer's.
-    let last = guides.iter().rposition(|g| !g.racing_line).unwrap_or(0);
+    let last = guides
+        .iter()
+        .rposition(|g| g.kind != GuideKind::RacingLine)
+        .unwrap_or(0);
     let jobs: Vec<(Option<Cornering>, usize)> = first
         .into_iter()
         .chain(cornering.iter().copied().map(Some))
@@ -596,7 +605,7 @@ fn sweep_guides(
             let racing = matches!(way, Some(Cornering::Curvature(_)));
             (0..guides.len())
                 .filter(move |&i| {
-                    if guides[i].racing_line {
+                    if guides[i].kind == GuideKind::RacingLine {
                         racing
                     } else {
                         !racing && (!limited || i == 0 || i == last)
@@ -671,7 +680,7 @@ fn sweep_guide(
         }
         let guide = GreedyGuide {
             clearance_units: g.clearance_units,
-            centre_line: g.centre_line,
+            centre_line: g.kind == GuideKind::CentreLine,
             lookahead_units: la,
             speed_cap_ups: cap,
             corner_bend_units,
@@ -804,7 +813,7 @@ mod tests {
         let guides = guide_paths(&sim, &bound);
         let line = guides
             .iter()
-            .find(|g| g.racing_line)
+            .find(|g| g.kind == GuideKind::RacingLine)
             .unwrap_or_else(|| panic!("no racing line"));
         let every = point_speeds(&scene, &line.path, 1.0);
         let kept = binding(every.clone());
