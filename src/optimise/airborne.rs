@@ -1,18 +1,16 @@
 //! The airborne solve, stages 2 to 4 of [`super::search`], in this order:
 //!
-//! 1. the relaxed line ([`super::relaxed`]) at the planning margin, which leaves room for the zigzag of
-//!    rounded sides; the count search over it is the search's globalisation;
+//! 1. the relaxed line ([`super::relaxed`]) at the planning margin ([`planning_margin`]), which leaves
+//!    room for the zigzag of rounded sides; the count search over it is the search's globalisation;
 //! 2. the certificate: the relaxed optimum from that line and from the other clean greedy runs, the
 //!    greedy starts on a second thread, beside everything else (they need nothing of the relaxed line);
-//! 3. the same line refined at the tight margin, where the zigzag of real sides is counted at what it is
-//!    rather than at the most a braking frame could swing;
-//! 4. each line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
+//! 3. the line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
 //!    fastest valid exact plan is kept;
-//! 5. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]);
-//! 6. where it still crosses in a later frame than the certificate's fastest line, by more than the
+//! 4. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]);
+//! 5. where it still crosses in a later frame than the certificate's fastest line, by more than the
 //!    estimates say a replayable plan loses, that line refined at the final margin and rounded again
 //!    ([`certificate_line_rounded_at_the_final_margin`]);
-//! 7. where the settings ask for it (`balanced` and `exact`), polished on again at smaller wall margins
+//! 6. where the settings ask for it (`balanced` and `exact`), polished on again at smaller wall margins
 //!    ([`plan_polished_finely`], run by [`super::search`] after the rest).
 //!
 //! Where the relaxed stage finds no line from the seed, the certificate's greedy starts' lines are the
@@ -29,6 +27,7 @@ use super::relaxed::{
 use super::scp::StageKind;
 use super::search::{seconds_since, FinePolish, Progress, SearchSettings};
 use super::verify::quantised_and_verified;
+use crate::physics::step::AccelLaw;
 use crate::sim::{Crossing, Trace};
 use std::time::Instant;
 
@@ -54,34 +53,39 @@ const FINAL_MARGIN_ROUNDS: usize = 3;
 /// Final wall margins tried, as multiples of the setting, until a plan stays valid.
 const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
 
-/// The tight line is solved only where its margin is at most this share of the planning margin: closer
-/// to it the two lines are one (at 100 fps with air acceleration 10, `L = 30` and `gamma1 = 32`: the
-/// margins differ by 6%).
-const TIGHT_MARGIN_MAX_SHARE: f64 = 0.9;
+/// Where the zigzag's margin is more than this share of the braking swing's, the two are one (at 100 fps
+/// with air acceleration 10, `L = 30` and `gamma1 = 32`: they differ by 6%) and the planning margin is
+/// the wider ([`planning_margin`]).
+const ZIGZAG_MARGIN_MAX_SHARE: f64 = 0.9;
 
-/// The wall margins of the relaxed lines, units.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct LineMargins {
-    /// The planning margin: the final margin and `tau max(L, gamma1)`, the largest sideways push a frame
-    /// can give (a braking frame's, `gamma1`), so that any rounding of the sides stays clear.
-    pub(super) planning: f64,
-    /// The tight margin: the final margin and `tau min(L, gamma1)`, twice the swing of alternating sides
-    /// at full acceleration (`mu = min(L, gamma1)`, docs/physics.md section 6, moves the path
-    /// `tau mu / 2` either side of the relaxed one); `None` where it is no tighter than the planning one.
-    pub(super) tight: Option<f64>,
+/// The wall margin of the relaxed line, units: the final margin and the sideways room its rounding
+/// needs. Alternating sides at full acceleration (`mu = min(L, gamma1)`, docs/physics.md section 6)
+/// swing the path `tau mu / 2` either side of the relaxed one, so the zigzag's margin is the final
+/// margin and `tau min(L, gamma1)`. A braking frame can push further, `tau max(L, gamma1)`; where the
+/// two are within [`ZIGZAG_MARGIN_MAX_SHARE`] of each other that wider one is kept. Where braking's is
+/// far wider (high air acceleration, low frame rates: 89 units at 60 fps with air acceleration 1000,
+/// against the zigzag's 0.5, more room than most corridors have), the plans came from lines far off the
+/// walls and were up to half a frame behind what a line at the zigzag's margin gives, and refining a
+/// tighter line from them did not win that back (docs/design.md, "The planning margin"). A rounding that
+/// brakes against a wall is left to the polish, which widens the line where a rounding leaves the walls
+/// ([`MARGIN_RETRIES`]).
+pub(super) fn planning_margin(planner: &Planner) -> f64 {
+    planning_margin_of(
+        &planner.fl.law,
+        planner.fl.tau_s,
+        planner.settings.margin_units,
+    )
 }
 
-impl LineMargins {
-    /// The margins of `planner`'s frame law.
-    pub(super) fn of(planner: &Planner) -> Self {
-        let fl = planner.fl;
-        let final_margin = planner.settings.margin_units;
-        let planning = final_margin + fl.tau_s * fl.law.l.max(fl.law.gamma1);
-        let tight = final_margin + fl.tau_s * fl.law.l.min(fl.law.gamma1);
-        LineMargins {
-            planning,
-            tight: (tight <= TIGHT_MARGIN_MAX_SHARE * planning).then_some(tight),
-        }
+/// [`planning_margin`] for the air law `law` at frame time `tau_s` and final margin `final_margin`
+/// (units).
+fn planning_margin_of(law: &AccelLaw, tau_s: f64, final_margin: f64) -> f64 {
+    let braking = final_margin + tau_s * law.l.max(law.gamma1);
+    let zigzag = final_margin + tau_s * law.l.min(law.gamma1);
+    if zigzag <= ZIGZAG_MARGIN_MAX_SHARE * braking {
+        zigzag
+    } else {
+        braking
     }
 }
 
@@ -95,9 +99,6 @@ struct Source {
 /// What is widened where none of a line's plans rounded at the first horizon stays valid.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Widening {
-    /// Nothing: the tight line, whose plans only add candidates (at a wider margin it would be the
-    /// planning line again).
-    None,
     /// The final margin ([`FINAL_MARGIN_FACTORS`]): a certificate's line beside a valid plan. Its plans
     /// only add candidates too, but a plan valid in the model can scrape a wall once its yaws are
     /// quantised, and a wider final margin is a polish more; re-solving the line wider is a relaxed stage
@@ -136,13 +137,13 @@ pub(super) fn plan_airborne(
     greedy_s: f64,
     progress: &mut dyn FnMut(Progress),
 ) -> AirbornePlan {
-    let margins = LineMargins::of(planner);
+    let margin = planning_margin(planner);
     let first_started = Instant::now();
     let greedy_starts = certificate_greedy_starts(planner, base);
-    let planning = Relaxation::planning(margins.planning);
+    let planning = Relaxation::planning(margin);
     let side = move |fork: &mut Planner| certified_greedy_starts(fork, greedy_starts, planning, lo);
     let (mine, side_certifiers) = beside_certificate_starts(planner, vec![side], |planner| {
-        lines_and_plans(planner, warm, n, lo, margins, greedy_s, progress)
+        lines_and_plans(planner, warm, n, lo, margin, greedy_s, progress)
     });
     // The relaxed line and the waits are clocked on their own, inside.
     planner.seconds.first_plans = seconds_since(first_started)
@@ -165,7 +166,7 @@ pub(super) fn plan_airborne(
     }
     let terms = PlanTerms {
         lo,
-        margins,
+        planning_margin: margin,
         greedy_s,
     };
     planner.clocked(
@@ -425,11 +426,12 @@ fn behind_beyond_estimates(
 }
 
 /// What the exact plans of a certificate's line are held to: no plan crosses before frame `lo`, each
-/// is rounded from lines at `margins`, and one is kept only if faster than `greedy_s` seconds.
+/// is rounded from lines at `planning_margin` (units), and one is kept only if faster than `greedy_s`
+/// seconds.
 #[derive(Clone, Copy)]
 struct PlanTerms {
     lo: usize,
-    margins: LineMargins,
+    planning_margin: f64,
     greedy_s: f64,
 }
 
@@ -501,7 +503,7 @@ fn plans_of_certificate_line(
         Some(_) => Widening::FinalMargin,
         None => Widening::FinalMarginAndLine,
     };
-    let planning = terms.margins.planning;
+    let planning = terms.planning_margin;
     let source = refined(
         planner,
         progress,
@@ -627,20 +629,20 @@ fn certified_greedy_starts(
     certifier
 }
 
-/// The relaxed line, the certificate's start from it, the tight line, and the exact plans of both lines,
+/// The relaxed line at `margin` (units), the certificate's start from it, and the line's exact plans,
 /// with the frame the relaxed line crosses in; `None` when the relaxed stage found no line. The
-/// certificate's start from the relaxed line is solved on a fork beside the tight line and the exact
-/// plans: both begin at the relaxed line and neither needs the other.
+/// certificate's start from the relaxed line is solved on a fork beside the exact plans: both begin at
+/// the relaxed line and neither needs the other.
 fn lines_and_plans(
     planner: &mut Planner,
     warm: Vec<FrameControl>,
     n: usize,
     lo: usize,
-    margins: LineMargins,
+    margin: f64,
     greedy_s: f64,
     progress: &mut dyn FnMut(Progress),
 ) -> Option<(Certifier, BestPlan, u64)> {
-    let planning = Relaxation::planning(margins.planning);
+    let planning = Relaxation::planning(margin);
     let relaxed = planner.clocked(
         |s| &mut s.relaxed_line,
         |planner| relaxed_plan(planner, progress, warm, n, lo, planning, Descent::PLAN).line,
@@ -653,7 +655,7 @@ fn lines_and_plans(
         certifier
     };
     let (best, certifiers) = beside_certificate_starts(planner, vec![certify], |planner| {
-        exact_plans_of_both_lines(planner, relaxed, lo, margins, greedy_s, progress)
+        exact_plans_of_the_line(planner, relaxed, margin, greedy_s, progress)
     });
     let certifier = certifiers.into_iter().next().unwrap_or_default();
     Some((certifier, best, relaxed_line_frame))
@@ -681,39 +683,26 @@ where
     results
 }
 
-/// The tight line refined from the relaxed one, and the exact plans of both lines.
-fn exact_plans_of_both_lines(
+/// The exact plans of the relaxed line, solved at `margin` (units).
+fn exact_plans_of_the_line(
     planner: &mut Planner,
     relaxed: Vec<FrameControl>,
-    lo: usize,
-    margins: LineMargins,
+    margin: f64,
     greedy_s: f64,
     progress: &mut dyn FnMut(Progress),
 ) -> BestPlan {
-    let mut sources = vec![Source {
-        line: relaxed.clone(),
-        margin: margins.planning,
+    let source = Source {
+        line: relaxed,
+        margin,
         widening: Widening::FinalMarginAndLine,
-    }];
-    if let Some(tight) = margins.tight {
-        sources.extend(refined(
-            planner,
-            progress,
-            relaxed,
-            lo,
-            tight,
-            Widening::None,
-        ));
-    }
+    };
     progress(Progress::Finishing);
     let mut best = None;
-    for source in &sources {
-        exact_plans(planner, source, greedy_s, &mut best);
-    }
+    exact_plans(planner, &source, greedy_s, &mut best);
     best
 }
 
-/// Stages 3 and 4 for one relaxed line: rounded, polished, quantised and verified, first at the settings'
+/// Stage 3 for one relaxed line: rounded, polished, quantised and verified, first at the settings'
 /// final margin; if no plan rounded at the first horizon stays valid (a tight margin along a long wall),
 /// again as the line's [`Widening`] allows. A plan replaces `best` when it is faster (and faster than
 /// `greedy_s`); a plan whose replay fails is kept aside if it was planned to cross before every other
@@ -721,7 +710,6 @@ fn exact_plans_of_both_lines(
 fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut BestPlan) {
     let final_margin_units = planner.settings.margin_units;
     let (factors, margin_retries) = match source.widening {
-        Widening::None => (&FINAL_MARGIN_FACTORS[..1], 0),
         Widening::FinalMargin => (&FINAL_MARGIN_FACTORS[..], 0),
         Widening::FinalMarginAndLine => (&FINAL_MARGIN_FACTORS[..], MARGIN_RETRIES),
     };
@@ -855,7 +843,7 @@ pub(super) fn plan_polished_finely(
     if faster {
         let terms = PlanTerms {
             lo,
-            margins: LineMargins::of(planner),
+            planning_margin: planning_margin(planner),
             greedy_s,
         };
         let (certifier, best) = (&mut found.certifier, &mut found.best);
@@ -898,10 +886,12 @@ fn kept_if_faster(best: &mut BestPlan, greedy_s: f64, t: f64, trace: Trace) -> b
 mod tests {
     use super::*;
     use crate::budget::Budget;
+    use crate::optimise::model::FrameLaw;
     use crate::optimise::planner::{planning_inputs, staircase_scene, with_fast_planner};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::verify::time_of;
     use crate::optimise::Quality;
+    use crate::physics::MovementVars;
 
     #[test]
     fn a_plan_is_behind_a_certificate_line_only_in_a_later_frame_and_beyond_the_estimates() {
@@ -942,6 +932,29 @@ mod tests {
             frame,
             || 0.0
         ));
+    }
+
+    #[test]
+    fn the_line_keeps_the_zigzags_margin_unless_a_braking_frames_is_within_a_tenth_of_it() {
+        // Half-Life's air law at a frame rate and air acceleration, and the final margin 0.02 units.
+        let at = |fps: f64, airaccelerate: f64| {
+            let vars = MovementVars {
+                airaccelerate,
+                ..MovementVars::goldsrc(fps)
+            };
+            let fl = FrameLaw::of(&vars);
+            planning_margin_of(&fl.law, fl.tau_s, 0.02)
+        };
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        // 100 fps, air acceleration 10: `L = 30` and `gamma1 = 32`, the zigzag's and the braking swings
+        // 0.30 and 0.32 units are one; the wider is kept.
+        assert!(close(at(100.0, 10.0), 0.34), "{}", at(100.0, 10.0));
+        // Air acceleration 100: `gamma1 = 320`, a braking frame's 3.2 units against the zigzag's 0.3.
+        assert!(close(at(100.0, 100.0), 0.32), "{}", at(100.0, 100.0));
+        // 60 fps, air acceleration 1000: the zigzag's 0.5 units.
+        assert!(close(at(60.0, 1000.0), 0.52), "{}", at(60.0, 1000.0));
+        // 250 fps, air acceleration 10: `gamma1 = 12.8` is the smaller, 0.0512 units against 0.12.
+        assert!(close(at(250.0, 10.0), 0.0712), "{}", at(250.0, 10.0));
     }
 
     #[test]

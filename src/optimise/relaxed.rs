@@ -717,7 +717,7 @@ impl Certifier {
 mod tests {
     use super::*;
     use crate::budget::Budget;
-    use crate::optimise::airborne::LineMargins;
+    use crate::optimise::airborne::planning_margin;
     use crate::optimise::model::rollout;
     use crate::optimise::planner::{planning_inputs, staircase_scene, with_planner};
     use crate::optimise::qp::SubProblemSolver;
@@ -1079,7 +1079,7 @@ mod tests {
         let half = warm[..warm.len() / 2].to_vec();
         let n = half.len();
         let mut certifier = Certifier::default();
-        let planning = Relaxation::planning(LineMargins::of(&planner).planning);
+        let planning = Relaxation::planning(planning_margin(&planner));
         let counts = counts_tried(|record| {
             let kind = StartKind::Greedy { planning };
             certifier.add_start(&mut planner, record, half.clone(), kind, 0);
@@ -1129,7 +1129,7 @@ mod tests {
     ) -> Vec<u64> {
         let warm = planner.warm_start(&base.clean[1].trace);
         let n = warm.len();
-        let planning = Relaxation::planning(LineMargins::of(planner).planning);
+        let planning = Relaxation::planning(planning_margin(planner));
         let certificate = Relaxation::certificate();
         let mut ends = Vec::new();
         for first in [Some(planning), None] {

@@ -296,7 +296,7 @@ pub struct StageSeconds {
     pub baseline: f64,
     /// The relaxed line from the seed: its count search, coarse to fine.
     pub relaxed_line: f64,
-    /// The relaxed and tight lines rounded, polished and verified.
+    /// The relaxed line rounded, polished and verified.
     pub first_plans: f64,
     /// The first plans done, the wait for the certificate's starts still running on other threads (its
     /// greedy starts, and its start from the relaxed line).
