@@ -27,7 +27,6 @@ use super::relaxed::{
 use super::scp::StageKind;
 use super::search::{seconds_since, FinePolish, Progress, SearchSettings};
 use super::verify::quantised_and_verified;
-use crate::physics::step::AccelLaw;
 use crate::sim::{Crossing, Trace};
 use std::time::Instant;
 
@@ -53,40 +52,10 @@ const FINAL_MARGIN_ROUNDS: usize = 3;
 /// Final wall margins tried, as multiples of the setting, until a plan stays valid.
 const FINAL_MARGIN_FACTORS: [f64; 3] = [1.0, 3.0, 10.0];
 
-/// Where the zigzag's margin is more than this share of the braking swing's, the two are one (at 100 fps
-/// with air acceleration 10, `L = 30` and `gamma1 = 32`: they differ by 6%) and the planning margin is
-/// the wider ([`planning_margin`]).
-const ZIGZAG_MARGIN_MAX_SHARE: f64 = 0.9;
-
-/// The wall margin of the relaxed line, units: the final margin and the sideways room its rounding
-/// needs. Alternating sides at full acceleration (`mu = min(L, gamma1)`, docs/physics.md section 6)
-/// swing the path `tau mu / 2` either side of the relaxed one, so the zigzag's margin is the final
-/// margin and `tau min(L, gamma1)`. A braking frame can push further, `tau max(L, gamma1)`; where the
-/// two are within [`ZIGZAG_MARGIN_MAX_SHARE`] of each other that wider one is kept. Where braking's is
-/// far wider (high air acceleration, low frame rates: 89 units at 60 fps with air acceleration 1000,
-/// against the zigzag's 0.5, more room than most corridors have), the plans came from lines far off the
-/// walls and were up to half a frame behind what a line at the zigzag's margin gives, and refining a
-/// tighter line from them did not win that back (docs/design.md, "The planning margin"). A rounding that
-/// brakes against a wall is left to the polish, which widens the line where a rounding leaves the walls
-/// ([`MARGIN_RETRIES`]).
+/// The wall margin the relaxed line is planned at, units ([`super::model::FrameLaw::planning_margin`]
+/// of `planner`'s frame law and final margin).
 pub(super) fn planning_margin(planner: &Planner) -> f64 {
-    planning_margin_of(
-        &planner.fl.law,
-        planner.fl.tau_s,
-        planner.settings.margin_units,
-    )
-}
-
-/// [`planning_margin`] for the air law `law` at frame time `tau_s` and final margin `final_margin`
-/// (units).
-fn planning_margin_of(law: &AccelLaw, tau_s: f64, final_margin: f64) -> f64 {
-    let braking = final_margin + tau_s * law.l.max(law.gamma1);
-    let zigzag = final_margin + tau_s * law.l.min(law.gamma1);
-    if zigzag <= ZIGZAG_MARGIN_MAX_SHARE * braking {
-        zigzag
-    } else {
-        braking
-    }
+    planner.fl.planning_margin(planner.settings.margin_units)
 }
 
 /// A relaxed line to round, and the margin it was solved at.
@@ -143,7 +112,7 @@ pub(super) fn plan_airborne(
     let planning = Relaxation::planning(margin);
     let side = move |fork: &mut Planner| certified_greedy_starts(fork, greedy_starts, planning, lo);
     let (mine, side_certifiers) = beside_certificate_starts(planner, vec![side], |planner| {
-        lines_and_plans(planner, warm, n, lo, margin, greedy_s, progress)
+        lines_and_plans(planner, warm, n, lo, planning, greedy_s, progress)
     });
     // The relaxed line and the waits are clocked on their own, inside.
     planner.seconds.first_plans = seconds_since(first_started)
@@ -629,7 +598,7 @@ fn certified_greedy_starts(
     certifier
 }
 
-/// The relaxed line at `margin` (units), the certificate's start from it, and the line's exact plans,
+/// The relaxed line of `planning`, the certificate's start from it, and the line's exact plans,
 /// with the frame the relaxed line crosses in; `None` when the relaxed stage found no line. The
 /// certificate's start from the relaxed line is solved on a fork beside the exact plans: both begin at
 /// the relaxed line and neither needs the other.
@@ -638,11 +607,10 @@ fn lines_and_plans(
     warm: Vec<FrameControl>,
     n: usize,
     lo: usize,
-    margin: f64,
+    planning: Relaxation,
     greedy_s: f64,
     progress: &mut dyn FnMut(Progress),
 ) -> Option<(Certifier, BestPlan, u64)> {
-    let planning = Relaxation::planning(margin);
     let relaxed = planner.clocked(
         |s| &mut s.relaxed_line,
         |planner| relaxed_plan(planner, progress, warm, n, lo, planning, Descent::PLAN).line,
@@ -655,7 +623,7 @@ fn lines_and_plans(
         certifier
     };
     let (best, certifiers) = beside_certificate_starts(planner, vec![certify], |planner| {
-        exact_plans_of_the_line(planner, relaxed, margin, greedy_s, progress)
+        exact_plans_of_the_line(planner, relaxed, planning.margin_units, greedy_s, progress)
     });
     let certifier = certifiers.into_iter().next().unwrap_or_default();
     Some((certifier, best, relaxed_line_frame))
@@ -886,12 +854,10 @@ fn kept_if_faster(best: &mut BestPlan, greedy_s: f64, t: f64, trace: Trace) -> b
 mod tests {
     use super::*;
     use crate::budget::Budget;
-    use crate::optimise::model::FrameLaw;
     use crate::optimise::planner::{planning_inputs, staircase_scene, with_fast_planner};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::verify::time_of;
     use crate::optimise::Quality;
-    use crate::physics::MovementVars;
 
     #[test]
     fn a_plan_is_behind_a_certificate_line_only_in_a_later_frame_and_beyond_the_estimates() {
@@ -932,29 +898,6 @@ mod tests {
             frame,
             || 0.0
         ));
-    }
-
-    #[test]
-    fn the_line_keeps_the_zigzags_margin_unless_a_braking_frames_is_within_a_tenth_of_it() {
-        // Half-Life's air law at a frame rate and air acceleration, and the final margin 0.02 units.
-        let at = |fps: f64, airaccelerate: f64| {
-            let vars = MovementVars {
-                airaccelerate,
-                ..MovementVars::goldsrc(fps)
-            };
-            let fl = FrameLaw::of(&vars);
-            planning_margin_of(&fl.law, fl.tau_s, 0.02)
-        };
-        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
-        // 100 fps, air acceleration 10: `L = 30` and `gamma1 = 32`, the zigzag's and the braking swings
-        // 0.30 and 0.32 units are one; the wider is kept.
-        assert!(close(at(100.0, 10.0), 0.34), "{}", at(100.0, 10.0));
-        // Air acceleration 100: `gamma1 = 320`, a braking frame's 3.2 units against the zigzag's 0.3.
-        assert!(close(at(100.0, 100.0), 0.32), "{}", at(100.0, 100.0));
-        // 60 fps, air acceleration 1000: the zigzag's 0.5 units.
-        assert!(close(at(60.0, 1000.0), 0.52), "{}", at(60.0, 1000.0));
-        // 250 fps, air acceleration 10: `gamma1 = 12.8` is the smaller, 0.0512 units against 0.12.
-        assert!(close(at(250.0, 10.0), 0.0712), "{}", at(250.0, 10.0));
     }
 
     #[test]

@@ -67,6 +67,11 @@ impl AngleControl {
 /// The strongest braking a plan uses, as `-cos theta` of the strafe angle (see [`FrameLaw::c_min`]).
 const BRAKE_COS_LIMIT: f64 = 0.95;
 
+/// Where the zigzag's margin is more than this share of the braking swing's, the two are one (at 100 fps
+/// with air acceleration 10, `L = 30` and `gamma1 = 32`: they differ by 6%) and the planning margin is
+/// the wider ([`FrameLaw::planning_margin`]).
+const ZIGZAG_MARGIN_MAX_SHARE: f64 = 0.9;
+
 /// The constants of one airborne frame: frame time and the acceleration law.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameLaw {
@@ -96,6 +101,28 @@ impl FrameLaw {
     /// closer than this.
     pub fn angle_step_ups(&self, v: f64) -> f64 {
         v * self.angle_control.step_rad()
+    }
+
+    /// The wall margin a relaxed line is planned at, units: `final_margin` and the sideways room the
+    /// rounding of its sides needs. Alternating sides at full acceleration (`mu = min(L, gamma1)`,
+    /// docs/physics.md section 6) swing the path `tau mu / 2` either side of the relaxed one, so the
+    /// zigzag's margin is `final_margin + tau min(L, gamma1)`. A braking frame can push further,
+    /// `tau max(L, gamma1)`; where the two are within [`ZIGZAG_MARGIN_MAX_SHARE`] of each other that
+    /// wider one is kept. Where braking's is far wider (high air acceleration, low frame rates: 89 units
+    /// at 60 fps with air acceleration 1000, against the zigzag's 0.5, more room than most corridors
+    /// have), the plans came from lines far off the walls and were up to half a frame behind what a
+    /// line at the zigzag's margin gives, and refining a tighter line from them did not win that back
+    /// (docs/design.md, "The planning margin"). A rounding that brakes against a wall is left to the
+    /// polish, which widens the line where a rounding leaves the walls.
+    pub fn planning_margin(&self, final_margin: f64) -> f64 {
+        let AccelLaw { l, gamma1 } = self.law;
+        let braking = final_margin + self.tau_s * l.max(gamma1);
+        let zigzag = final_margin + self.tau_s * l.min(gamma1);
+        if zigzag <= ZIGZAG_MARGIN_MAX_SHARE * braking {
+            zigzag
+        } else {
+            braking
+        }
     }
 
     /// The `c` of maximum acceleration at speed `v` (docs/physics.md section 6): `min(L - gamma1, V)` in case 1,
@@ -811,6 +838,28 @@ pub fn frame_control_of(vel: Vec2, c: &Control) -> FrameControl {
 mod tests {
     use super::*;
     use crate::physics::{Effects, MovementVars, PlayerState, Stepper};
+
+    #[test]
+    fn the_line_keeps_the_zigzags_margin_unless_a_braking_frames_is_within_a_tenth_of_it() {
+        // Half-Life's air law at a frame rate and air acceleration, and the final margin 0.02 units.
+        let at = |fps: f64, airaccelerate: f64| {
+            let vars = MovementVars {
+                airaccelerate,
+                ..MovementVars::goldsrc(fps)
+            };
+            FrameLaw::of(&vars).planning_margin(0.02)
+        };
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        // 100 fps, air acceleration 10: `L = 30` and `gamma1 = 32`, the zigzag's and the braking swings
+        // 0.30 and 0.32 units are one; the wider is kept.
+        assert!(close(at(100.0, 10.0), 0.34), "{}", at(100.0, 10.0));
+        // Air acceleration 100: `gamma1 = 320`, a braking frame's 3.2 units against the zigzag's 0.3.
+        assert!(close(at(100.0, 100.0), 0.32), "{}", at(100.0, 100.0));
+        // 60 fps, air acceleration 1000: the zigzag's 0.5 units.
+        assert!(close(at(60.0, 1000.0), 0.52), "{}", at(60.0, 1000.0));
+        // 250 fps, air acceleration 10: `gamma1 = 12.8` is the smaller, 0.0512 units against 0.12.
+        assert!(close(at(250.0, 10.0), 0.0712), "{}", at(250.0, 10.0));
+    }
 
     /// A state for the derivative tests.
     const SAMPLE_STATE: ModelState = ModelState {

@@ -68,7 +68,7 @@ impl SubStepSetup {
             controls.push(frame_control_of(vel, c));
             vel = rec.vel;
         }
-        let margin = settings.margin_units + fl.tau_s * fl.law.l.max(fl.law.gamma1);
+        let margin = fl.planning_margin(settings.margin_units);
         let mut jacobians = Vec::with_capacity(controls.len());
         let mut positions = Vec::with_capacity(controls.len());
         let mut sigma_range = Vec::with_capacity(controls.len());
