@@ -6,7 +6,9 @@
 //!    greedy starts on a second thread, beside everything else (they need nothing of the relaxed line);
 //! 3. the line rounded, polished, quantised and verified ([`super::polish`], [`super::verify`]): the
 //!    fastest valid exact plan is kept;
-//! 4. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]);
+//! 4. that plan polished on from its own controls while it gets faster ([`best_plan_polished_on`]),
+//!    after a faster plan whose replay scraped a wall was planned on from that replay
+//!    ([`super::anchored`]) or polished wider ([`failed_plan_polished_wider`]);
 //! 5. where it still crosses in a later frame than the certificate's fastest line, by more than the
 //!    estimates say a replayable plan loses, that line refined at the final margin and rounded again
 //!    ([`certificate_line_rounded_at_the_final_margin`]);
@@ -16,6 +18,7 @@
 //! Where the relaxed stage finds no line from the seed, the certificate's greedy starts' lines are the
 //! ones rounded.
 
+use super::anchored::failed_plan_planned_on_from_its_replay;
 use super::baseline::Baseline;
 use super::model::{rollout, FrameControl};
 use super::planner::Planner;
@@ -159,6 +162,15 @@ pub(super) fn plan_airborne(
                 progress,
                 &mut best,
             );
+            if failed_plan_planned_on_from_its_replay(planner, terms.greedy_s, &mut best) {
+                polished_plan_as_certificate_start(
+                    planner,
+                    &mut certifier,
+                    terms,
+                    progress,
+                    &mut best,
+                );
+            }
         },
     );
     AirbornePlan {
@@ -229,6 +241,9 @@ fn plan_polished_on(
     best: &mut BestPlan,
 ) {
     let greedy_s = terms.greedy_s;
+    if failed_plan_planned_on_from_its_replay(planner, greedy_s, best) {
+        polished_plan_as_certificate_start(planner, certifier, terms, progress, best);
+    }
     if failed_plan_polished_wider(planner, greedy_s, best) {
         polished_plan_as_certificate_start(planner, certifier, terms, progress, best);
     }
@@ -842,7 +857,7 @@ fn plans_polished_again(
 
 /// The plan `(t, trace)` made the best if it is faster than the best so far and than `greedy_s`
 /// (seconds); whether it was.
-fn kept_if_faster(best: &mut BestPlan, greedy_s: f64, t: f64, trace: Trace) -> bool {
+pub(super) fn kept_if_faster(best: &mut BestPlan, greedy_s: f64, t: f64, trace: Trace) -> bool {
     let faster = t < best.as_ref().map_or(greedy_s, |b| b.0);
     if faster {
         *best = Some((t, trace));

@@ -3,6 +3,7 @@
 //! boost ([`jumps`]) and ground frames, jumps and the bunnyhop cap ([`hops`]).
 
 mod airborne;
+mod anchored;
 mod baseline;
 pub mod bound;
 pub mod hillclimb;

@@ -113,6 +113,26 @@ impl<'a> Planner<'a> {
         }
     }
 
+    /// A [`Planner::fork`] that plans on from `replay` (a run of this planner's prefix and then a plan)
+    /// after the plan's first `frames` frames: its prefix is this one's and the replay's controls of those
+    /// frames, as they were played, and its start the replay's state after them.
+    pub(super) fn fork_after(&self, replay: &Trace, frames: usize) -> Planner<'a> {
+        let played = (self.prefix.len() + frames).min(replay.controls.len());
+        let start = played
+            .checked_sub(1)
+            .and_then(|i| replay.frames.get(i))
+            .map_or(self.start, |f| ModelState {
+                pos: f.pos,
+                speed: f.vel.length(),
+                heading: f.vel.angle(),
+            });
+        Planner {
+            start,
+            prefix: replay.controls[..played].to_vec(),
+            ..self.fork()
+        }
+    }
+
     /// A [`Planner::fork`] at other `settings`, for a stage run at settings of its own on this thread.
     pub(super) fn fork_with<'b>(&self, settings: &'b SearchSettings) -> Planner<'b>
     where

@@ -102,8 +102,7 @@ pub(super) fn quantised_and_verified(
     planner: &mut Planner,
     plan: Vec<FrameControl>,
 ) -> Option<(f64, Trace)> {
-    let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan, planner.fl, true);
-    let trace = planner.sim.run_within(&mut player, &planner.budget);
+    let trace = quantised_replay(planner, plan);
     if trace.interrupted {
         planner.timed_out = true;
         planner.note_cut(Stage::Verification);
@@ -124,6 +123,13 @@ pub(super) fn quantised_and_verified(
     let valid = run.feasible();
     planner.stats.valid_replays += u64::from(valid);
     valid.then_some((t, trace))
+}
+
+/// `plan` after the planner's prefix, played through the real frame with quantised yaws
+/// ([`PlanPlayer`]), in `f64`: the run [`quantised_and_verified`] checks.
+pub(super) fn quantised_replay(planner: &Planner, plan: Vec<FrameControl>) -> Trace {
+    let mut player = PlanPlayer::new(&planner.start, &planner.prefix, plan, planner.fl, true);
+    planner.sim.run_within(&mut player, &planner.budget)
 }
 
 /// The largest distance (units) and speed difference (ups) between `plan` and its replay as verified
