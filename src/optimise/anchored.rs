@@ -18,7 +18,7 @@ use crate::sim::Trace;
 /// How long before a replay's first wall contact it is kept as played, seconds: the rest of the plan is
 /// polished again from there, so the polish has that much run-up to move the path off the wall by the
 /// drift (hundredths to tenths of a unit) without turning sharply.
-pub(super) const ANCHOR_BEFORE_CONTACT_S: f64 = 0.5;
+const ANCHOR_BEFORE_CONTACT_S: f64 = 0.5;
 
 /// Most times a plan is planned on from its replay: each time from a later contact, while the polished
 /// rest still fails its replay and is planned to cross before the best plan. A bound on the work.
