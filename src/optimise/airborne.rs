@@ -711,12 +711,7 @@ fn exact_plans(planner: &mut Planner, source: &Source, greedy_s: f64, best: &mut
             let primary = plan.primary;
             let kept = plan.controls.clone();
             let Some((t, trace)) = quantised_and_verified(planner, plan.controls) else {
-                let earliest = &mut planner.earliest_failed_plan;
-                if let Some(p) =
-                    planned.filter(|p| earliest.as_ref().is_none_or(|f| p.time < f.0.time))
-                {
-                    *earliest = Some((p, kept));
-                }
+                planner.note_failed_plan(planned, kept);
                 continue;
             };
             // A replay that fell half a frame behind its plan scraped a wall the margin did not keep it
@@ -847,9 +842,12 @@ fn plans_polished_again(
 ) -> (bool, bool) {
     let (mut valid, mut faster) = (false, false);
     for plan in polished_again(planner, controls, margin, kind) {
-        if let Some((t, trace)) = quantised_and_verified(planner, plan) {
+        let planned = planner.crossing_of(&plan);
+        if let Some((t, trace)) = quantised_and_verified(planner, plan.clone()) {
             valid = true;
             faster |= kept_if_faster(best, greedy_s, t, trace);
+        } else {
+            planner.note_failed_plan(planned, plan);
         }
     }
     (valid, faster)

@@ -113,6 +113,19 @@ impl<'a> Planner<'a> {
         }
     }
 
+    /// A plan whose replay failed, planned to cross at `planned` in the model (`None`: it does not reach
+    /// the line), kept as [`Planner::earliest_failed_plan`] where it crosses before the one kept so far.
+    pub(super) fn note_failed_plan(
+        &mut self,
+        planned: Option<Crossing>,
+        controls: Vec<FrameControl>,
+    ) {
+        let earliest = &mut self.earliest_failed_plan;
+        if let Some(p) = planned.filter(|p| earliest.as_ref().is_none_or(|f| p.time < f.0.time)) {
+            *earliest = Some((p, controls));
+        }
+    }
+
     /// A [`Planner::fork`] that plans on from `replay` (a run of this planner's prefix and then a plan)
     /// after the plan's first `frames` frames: its prefix is this one's and the replay's controls of those
     /// frames, as they were played, and its start the replay's state after them.
