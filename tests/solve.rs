@@ -465,9 +465,7 @@ fn at_a_low_frame_rate_and_high_air_acceleration_the_plan_rounds_within_a_tenth_
         (d.fps, d.airaccelerate, d.width_units, d.start_speed_ups),
         (60, 1000, 134, 832)
     );
-    let (o, plan) = solved(&g.scene, Quality::Fast);
-    assert!(o.trace.feasible() && o.engine_exact.feasible());
-    let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
+    let (plan, r) = plan_and_certificate(&g.scene, &SearchSettings::for_quality(Quality::Fast));
     let loss_frames = (plan.time - r.time) / g.scene.frame_time_s();
     assert_eq!(plan.frames, r.frames, "{plan:?} against {r:?}");
     assert!(
@@ -491,9 +489,7 @@ fn a_plan_whose_replay_scrapes_a_wall_is_planned_on_from_its_replay_into_the_cer
     let g = generate(7272, 3, &family).unwrap_or_else(|e| panic!("{e}"));
     let d = &g.drawn;
     assert_eq!((d.fps, d.airaccelerate, d.width_units), (100, 10, 86));
-    let (o, plan) = solved(&g.scene, Quality::Fast);
-    assert!(o.trace.feasible() && o.engine_exact.feasible());
-    let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
+    let (plan, r) = plan_and_certificate(&g.scene, &SearchSettings::for_quality(Quality::Fast));
     assert_eq!(
         (plan.frames, r.frames),
         (592, 592),
@@ -596,7 +592,16 @@ fn ci_sized_plan_and_certificate_with(
 ) -> (Crossing, strafeopt::optimise::RelaxedCertificate) {
     let family = GeneratorSettings::ci_sized();
     let g = generate(seed, index, &family).unwrap_or_else(|e| panic!("{e}"));
-    let (o, plan) = solved_with(&g.scene, settings);
+    plan_and_certificate(&g.scene, settings)
+}
+
+/// `scene` solved with `settings`: the plan's crossing and the certificate, once the plan is checked valid
+/// in f64 and engine-exact.
+fn plan_and_certificate(
+    scene: &Scene,
+    settings: &SearchSettings,
+) -> (Crossing, strafeopt::optimise::RelaxedCertificate) {
+    let (o, plan) = solved_with(scene, settings);
     assert!(o.trace.feasible() && o.engine_exact.feasible());
     let r = o.relaxed.unwrap_or_else(|| panic!("no certificate"));
     (plan, r)

@@ -853,10 +853,15 @@ fn plans_polished_again(
     (valid, faster)
 }
 
+/// The time a plan must beat, seconds: the best plan's, or `greedy_s` where there is none.
+pub(super) fn time_to_beat(best: &BestPlan, greedy_s: f64) -> f64 {
+    best.as_ref().map_or(greedy_s, |b| b.0)
+}
+
 /// The plan `(t, trace)` made the best if it is faster than the best so far and than `greedy_s`
 /// (seconds); whether it was.
 pub(super) fn kept_if_faster(best: &mut BestPlan, greedy_s: f64, t: f64, trace: Trace) -> bool {
-    let faster = t < best.as_ref().map_or(greedy_s, |b| b.0);
+    let faster = t < time_to_beat(best, greedy_s);
     if faster {
         *best = Some((t, trace));
     }

@@ -7,12 +7,12 @@
 //! contact, and the rest of the plan is polished again from the replay's own state there: the drift so far
 //! is then part of the start, and the rest has less of it to come.
 
-use super::airborne::{kept_if_faster, BestPlan};
-use super::model::{rollout, FrameControl};
+use super::airborne::{kept_if_faster, time_to_beat, BestPlan};
+use super::model::FrameControl;
 use super::planner::Planner;
 use super::polish::polished_again;
-use super::scp::{StageKind, CLEAN_VIOLATION_UNITS};
-use super::verify::{quantised_and_verified, quantised_replay};
+use super::scp::StageKind;
+use super::verify::{quantised_replay, verified};
 use crate::sim::Trace;
 
 /// How long before a replay's first wall contact it is kept as played, seconds: the rest of the plan is
@@ -39,33 +39,36 @@ pub(super) fn failed_plan_planned_on_from_its_replay(
     let Some((planned, controls)) = planner.earliest_failed_plan.clone() else {
         return false;
     };
-    if planned.time >= best_time(best, greedy_s) || !keeps_the_walls(planner, &controls) {
+    if planned.time >= time_to_beat(best, greedy_s) || !planner.keeps_the_walls(&controls, 0.0) {
         return false;
     }
-    let mut on = planner.fork();
+    // A failed plan is kept without its replay; played again, the replay is the same to the bit.
+    let mut replay = quantised_replay(planner, controls.clone());
     let mut rest = controls;
+    let mut on = planner.fork();
     let mut improved = false;
     for _ in 0..MAX_ANCHORED_ROUNDS {
-        let Some((anchored, tail)) = anchored_before_contact(&on, rest) else {
+        let Some((anchored, tail)) = anchored_before_contact(&on, &replay, rest) else {
             break;
         };
         planner.join(&on);
         on = anchored;
         let margin = on.settings.margin_units;
-        let mut failed: Option<Vec<FrameControl>> = None;
+        let mut failed: Option<(Vec<FrameControl>, Trace)> = None;
         for plan in polished_again(&mut on, tail, margin, StageKind::Plain) {
             let planned_s = on.crossing_of(&plan).map(|c| c.time);
-            if let Some((t, trace)) = quantised_and_verified(&mut on, plan.clone()) {
-                improved |= kept_if_faster(best, greedy_s, t, trace);
+            let replayed = quantised_replay(&on, plan.clone());
+            if let Some(t) = verified(&mut on, &replayed) {
+                improved |= kept_if_faster(best, greedy_s, t, replayed);
             } else if failed.is_none()
-                && planned_s.is_some_and(|p| p < best_time(best, greedy_s))
-                && keeps_the_walls(&on, &plan)
+                && planned_s.is_some_and(|p| p < time_to_beat(best, greedy_s))
+                && on.keeps_the_walls(&plan, 0.0)
             {
-                failed = Some(plan);
+                failed = Some((plan, replayed));
             }
         }
         match failed {
-            Some(plan) if !on.timed_out => rest = plan,
+            Some(next) if !on.timed_out => (rest, replay) = next,
             _ => break,
         }
     }
@@ -73,29 +76,18 @@ pub(super) fn failed_plan_planned_on_from_its_replay(
     improved
 }
 
-/// The crossing time of `best`, or `greedy_s` where there is no plan, seconds.
-fn best_time(best: &BestPlan, greedy_s: f64) -> f64 {
-    best.as_ref().map_or(greedy_s, |b| b.0)
-}
-
-/// Whether `plan` from `planner`'s start keeps clear of the walls in the planning model.
-fn keeps_the_walls(planner: &Planner, plan: &[FrameControl]) -> bool {
-    let states = rollout(&planner.start, plan, &planner.fl);
-    planner.problem(0.0, false, 1).violation(&states) <= CLEAN_VIOLATION_UNITS
-}
-
-/// `plan` replayed from `planner`; where the replay touches a wall or a rule line, a fork of `planner`
-/// that plans on from the replay [`ANCHOR_BEFORE_CONTACT_S`] before that frame, and the plan's frames from
-/// there. `None` where the replay touches nothing (it failed elsewhere, or not at all) or was cut.
+/// Where `replay` (of `plan` from `planner`) touches a wall or a rule line, a fork of `planner` that plans
+/// on from the replay [`ANCHOR_BEFORE_CONTACT_S`] before that frame, and the plan's frames from there.
+/// `None` where the replay touches nothing (it failed elsewhere, or not at all) or was cut.
 fn anchored_before_contact<'a>(
     planner: &Planner<'a>,
+    replay: &Trace,
     plan: Vec<FrameControl>,
 ) -> Option<(Planner<'a>, Vec<FrameControl>)> {
-    let replay = quantised_replay(planner, plan.clone());
     if replay.interrupted {
         return None;
     }
-    let contact = first_touch(&replay)?;
+    let contact = first_touch(replay)?;
     // Frames are numbered from 1; the plan starts after the prefix.
     let contact_in_plan = usize::try_from(contact)
         .ok()?
@@ -103,7 +95,7 @@ fn anchored_before_contact<'a>(
     let back = (ANCHOR_BEFORE_CONTACT_S / planner.fl.tau_s).round() as usize;
     let kept = contact_in_plan.saturating_sub(back);
     let rest = plan.get(kept..)?.to_vec();
-    Some((planner.fork_after(&replay, kept), rest))
+    Some((planner.fork_after(replay, kept), rest))
 }
 
 /// The first frame of `replay` that touched a solid wall or crossed a rule line.
@@ -169,7 +161,8 @@ mod tests {
             let Some(touch) = first_touch(&replay) else {
                 panic!("the circling replay touches nothing");
             };
-            let Some((on, rest)) = anchored_before_contact(planner, circling.clone()) else {
+            let Some((on, rest)) = anchored_before_contact(planner, &replay, circling.clone())
+            else {
                 panic!("no anchor before the touch at frame {touch}");
             };
             let back = (ANCHOR_BEFORE_CONTACT_S / planner.fl.tau_s).round() as usize;
@@ -182,8 +175,9 @@ mod tests {
             assert_eq!(on.prefix.len(), planner.prefix.len() + kept);
             assert_eq!(rest, circling[kept..].to_vec());
             // The seed's clean run touches nothing: there is no anchor.
-            assert!(first_touch(&quantised_replay(planner, seed.clone())).is_none());
-            assert!(anchored_before_contact(planner, seed).is_none());
+            let clean = quantised_replay(planner, seed.clone());
+            assert!(first_touch(&clean).is_none());
+            assert!(anchored_before_contact(planner, &clean, seed).is_none());
         });
     }
 }

@@ -2,7 +2,7 @@
 //! direction of progress, the settings, the deadline and the work done so far.
 
 use super::model::{frame_control_of, rollout, FrameControl, FrameLaw, ModelState};
-use super::scp::{run_scp, ScpProblem, StageKind};
+use super::scp::{run_scp, ScpProblem, StageKind, CLEAN_VIOLATION_UNITS};
 use super::search::{seconds_since, SearchSettings, SearchStats, StageSeconds};
 use super::LowerBound;
 use crate::budget::{Budget, Stage};
@@ -111,6 +111,13 @@ impl<'a> Planner<'a> {
             earliest_failed_plan: None,
             seconds: StageSeconds::default(),
         }
+    }
+
+    /// Whether `plan` from this planner's start keeps `margin` units off the walls in the planning model
+    /// (a move counts as clear at half its margin: [`ScpProblem::violation`]).
+    pub(super) fn keeps_the_walls(&self, plan: &[FrameControl], margin: f64) -> bool {
+        let states = rollout(&self.start, plan, &self.fl);
+        self.problem(margin, false, 1).violation(&states) <= CLEAN_VIOLATION_UNITS
     }
 
     /// A plan whose replay failed, planned to cross at `planned` in the model (`None`: it does not reach

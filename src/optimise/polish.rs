@@ -200,10 +200,7 @@ fn polished(
     let exact = planner.stage_of(pr, exact, iters, kind).0;
     // A rounding inside a wall that the first stage could not move at all (every step rejected) does not
     // move in the second either.
-    let stuck = exact == rounded && {
-        let states = rollout(&planner.start, &exact, &planner.fl);
-        planner.problem(margin, false, 1).violation(&states) > CLEAN_VIOLATION_UNITS
-    };
+    let stuck = exact == rounded && !planner.keeps_the_walls(&exact, margin);
     if planner.timed_out || stuck {
         return Polished::only(exact);
     }

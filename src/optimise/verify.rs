@@ -103,26 +103,32 @@ pub(super) fn quantised_and_verified(
     plan: Vec<FrameControl>,
 ) -> Option<(f64, Trace)> {
     let trace = quantised_replay(planner, plan);
-    if trace.interrupted {
+    verified(planner, &trace).map(|t| (t, trace))
+}
+
+/// The crossing time of `replay` (a [`quantised_replay`]) where it is valid in f64 and in the
+/// engine-exact mode, replayed there from its controls.
+pub(super) fn verified(planner: &mut Planner, replay: &Trace) -> Option<f64> {
+    if replay.interrupted {
         planner.timed_out = true;
         planner.note_cut(Stage::Verification);
         return None;
     }
     planner.stats.replays += 1;
-    let t = time_of(&trace);
+    let t = time_of(replay);
     if !t.is_finite() {
         return None;
     }
     let run = planner
         .sim
-        .run_engine_exact_within(&trace.controls, &planner.budget);
+        .run_engine_exact_within(&replay.controls, &planner.budget);
     if run.interrupted {
         planner.timed_out = true;
         planner.note_cut(Stage::Verification);
     }
     let valid = run.feasible();
     planner.stats.valid_replays += u64::from(valid);
-    valid.then_some((t, trace))
+    valid.then_some(t)
 }
 
 /// `plan` after the planner's prefix, played through the real frame with quantised yaws
