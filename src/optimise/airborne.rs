@@ -19,7 +19,7 @@
 //! ones rounded.
 
 use super::anchored::failed_plan_planned_on_from_its_replay;
-use super::baseline::Baseline;
+use super::baseline::{is_clean, Baseline};
 use super::model::{rollout, FrameControl};
 use super::planner::Planner;
 use super::polish::{polished_again, rounded_and_polished, MARGIN_RETRIES};
@@ -114,8 +114,13 @@ pub(super) fn plan_airborne(
     let greedy_starts = certificate_greedy_starts(planner, base);
     let planning = Relaxation::planning(margin);
     let side = move |fork: &mut Planner| certified_greedy_starts(fork, greedy_starts, planning, lo);
+    let seed = Seed {
+        warm,
+        n,
+        greedy: greedy_beside_the_seed(base),
+    };
     let (mine, side_certifiers) = beside_certificate_starts(planner, vec![side], |planner| {
-        lines_and_plans(planner, warm, n, lo, planning, greedy_s, progress)
+        lines_and_plans(planner, seed, lo, planning, greedy_s, progress)
     });
     // The relaxed line and the waits are clocked on their own, inside.
     planner.seconds.first_plans = seconds_since(first_started)
@@ -619,8 +624,7 @@ fn certified_greedy_starts(
 /// the relaxed line and neither needs the other.
 fn lines_and_plans(
     planner: &mut Planner,
-    warm: Vec<FrameControl>,
-    n: usize,
+    seed: Seed,
     lo: usize,
     planning: Relaxation,
     greedy_s: f64,
@@ -628,7 +632,7 @@ fn lines_and_plans(
 ) -> Option<(Certifier, BestPlan, u64)> {
     let relaxed = planner.clocked(
         |s| &mut s.relaxed_line,
-        |planner| relaxed_plan(planner, progress, warm, n, lo, planning, Descent::PLAN).line,
+        |planner| relaxed_line(planner, progress, seed, lo, planning),
     )?;
     let relaxed_line_frame = planner.crossing_of(&relaxed).map_or(u64::MAX, |c| c.frames);
     let start = relaxed.clone();
@@ -642,6 +646,62 @@ fn lines_and_plans(
     });
     let certifier = certifiers.into_iter().next().unwrap_or_default();
     Some((certifier, best, relaxed_line_frame))
+}
+
+/// Where the relaxed stage starts: the seed's controls over `n` frames, and the valid greedy run where
+/// it is another run ([`greedy_beside_the_seed`]).
+struct Seed<'t> {
+    warm: Vec<FrameControl>,
+    n: usize,
+    greedy: Option<&'t Trace>,
+}
+
+/// The greedy run, where it is clean (a run the planning model can follow: valid, across the line, no
+/// wall touched) and not the seed. The seed is the fastest clean run of the strafer's own guides; a
+/// racing line's run can be faster. (A run that touches a wall is no start: the model, which has no
+/// collisions, leaves the corridor at the contact and the stage stalls there.)
+fn greedy_beside_the_seed(base: &Baseline) -> Option<&Trace> {
+    let greedy = &base.greedy.trace;
+    let crossing = greedy.crossing?;
+    let seed_s = base.seed().crossing.map(|c| c.time);
+    (is_clean(greedy) && seed_s != Some(crossing.time)).then_some(greedy)
+}
+
+/// The relaxed line from the seed; where it finds none, or one that crosses after the greedy run, also
+/// the line from that run, and whichever crosses sooner. A descent is local: it ends where its stage
+/// cannot reach the count below, and from a seed far slower than the greedy run it can end behind that
+/// run, whose own descent starts nearer the line.
+fn relaxed_line(
+    planner: &mut Planner,
+    progress: &mut dyn FnMut(Progress),
+    seed: Seed,
+    lo: usize,
+    planning: Relaxation,
+) -> Option<Vec<FrameControl>> {
+    let Seed { warm, n, greedy } = seed;
+    let line = relaxed_plan(planner, progress, warm, n, lo, planning, Descent::PLAN).line;
+    let line_s = crossing_s(planner, line.as_deref());
+    let Some((greedy, crossing)) = greedy.and_then(|g| Some((g, g.crossing?))) else {
+        return line;
+    };
+    if line_s <= crossing.time || planner.out_of_time() {
+        return line;
+    }
+    let start = planner.warm_start(greedy);
+    let m = (crossing.frames as usize).saturating_sub(planner.prefix.len());
+    let from_greedy = relaxed_plan(planner, progress, start, m, lo, planning, Descent::PLAN).line;
+    if crossing_s(planner, from_greedy.as_deref()) < line_s {
+        from_greedy
+    } else {
+        line
+    }
+}
+
+/// When `line` crosses the finish line in the model, seconds (infinite where it does not or there is
+/// no line).
+fn crossing_s(planner: &Planner, line: Option<&[FrameControl]>) -> f64 {
+    line.and_then(|l| planner.crossing_of(l))
+        .map_or(f64::INFINITY, |c| c.time)
 }
 
 /// `here` on `planner` while the certificate's starts `jobs` run on forks of it
@@ -981,6 +1041,38 @@ mod tests {
             (own.time - t).abs() < 0.5 * scene.frame_time_s(),
             "{own:?} against {t}"
         );
+    }
+
+    #[test]
+    fn a_seed_that_reaches_no_line_ahead_of_the_greedy_run_is_descended_from_that_run_too() {
+        with_fast_planner(&staircase_scene(1), |planner, base, bound| {
+            let lo = (bound.crossing.frames as usize).saturating_sub(1);
+            let planning = Relaxation::planning(planning_margin(planner));
+            let greedy = &base.greedy.trace;
+            let greedy_s = time_of(greedy);
+            let line_of = |planner: &mut Planner, warm: &[FrameControl], greedy| {
+                let seed = Seed {
+                    warm: warm.to_vec(),
+                    n: warm.len(),
+                    greedy,
+                };
+                relaxed_line(planner, &mut |_| {}, seed, lo, planning)
+            };
+            // An empty seed reaches nothing (its count grows a few frames at a time); beside the greedy
+            // run, the line is that run's, ahead of it.
+            assert!(line_of(planner, &[], None).is_none());
+            let from_greedy = line_of(planner, &[], Some(greedy));
+            let from_greedy_s = crossing_s(planner, from_greedy.as_deref());
+            assert!(
+                from_greedy_s < greedy_s,
+                "{from_greedy_s} s against {greedy_s} s"
+            );
+            // A seed whose line is ahead of the greedy run keeps it: no second descent.
+            let seed = planner.warm_start(base.seed());
+            let own = line_of(planner, &seed, None);
+            assert!(crossing_s(planner, own.as_deref()) < greedy_s);
+            assert!(own == line_of(planner, &seed, Some(greedy)));
+        });
     }
 
     #[test]

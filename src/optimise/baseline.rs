@@ -778,7 +778,7 @@ fn pick_greedy(
 }
 
 /// A run the planning model can follow: valid, finished, and touching no wall.
-fn is_clean(t: &Trace) -> bool {
+pub(super) fn is_clean(t: &Trace) -> bool {
     t.feasible() && t.crossing.is_some() && t.collisions() == 0
 }
 
