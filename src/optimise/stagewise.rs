@@ -390,18 +390,6 @@ struct Iterate {
     grad: Vec<[f64; 4 + MAX_FRAME_VARS]>,
 }
 
-impl Iterate {
-    /// Whether every variable, slack and dual is a finite number.
-    fn is_finite(&self) -> bool {
-        self.v
-            .iter()
-            .flatten()
-            .chain(&self.t)
-            .chain(&self.lambda)
-            .all(|x| x.is_finite())
-    }
-}
-
 /// A frame's part of the Newton system's factorisation.
 #[derive(Clone, Copy, Default)]
 struct FrameFactor {
@@ -453,10 +441,6 @@ struct Workspace {
 /// relative to the largest right-hand side (the tolerances of [`super::qp`]). The gap is absolute: the
 /// objective carries the weighted violation the trust region cannot remove (thousands of units where a
 /// start is far inside a wall), and a gap relative to it left a control 5e-4 short of its bound.
-/// Almost solved: within the tolerances loosened by [`ALMOST_FACTOR`] at the iteration cap, or where the
-/// Newton system cannot be factorised ([`NotStaged::Numerics`]), which happens as the active rows'
-/// weights grow near the solution (docs/design.md, "The iterate returned almost solved where the
-/// factorisation fails").
 ///
 /// With `warm`, the slacks and duals of each frame with as many rows as there start from there (see
 /// [`WarmStart`]); the other frames', and every primal variable, start as from cold.
@@ -494,18 +478,7 @@ pub(super) fn solve(
             Met::Almost => almost = true,
             Met::Not => almost = false,
         }
-        match mehrotra_step(p, &frames, &offsets, &mut it, &mut work) {
-            Ok(()) => {}
-            // The Newton system lost its digits (see [`NotStaged::Numerics`]) at an iterate that
-            // already meets the looser tolerances: that iterate is the solution, almost, as at the
-            // iteration cap (a failed factorisation leaves the iterate as it was).
-            Err(NotStaged::Numerics) if almost && it.is_finite() => {
-                return Ok(solution(
-                    p, &frames, &wall_rows, &offsets, it, true, iteration,
-                ));
-            }
-            Err(not) => return Err(not),
-        }
+        mehrotra_step(p, &frames, &offsets, &mut it, &mut work)?;
     }
     if almost {
         return Ok(solution(
@@ -828,39 +801,7 @@ fn factorised(
     it: &Iterate,
     factors: &mut Vec<FrameFactor>,
 ) -> Result<(), NotStaged> {
-    #[cfg(test)]
-    if forced_failure::now() {
-        return Err(NotStaged::Numerics);
-    }
     factorised_capped(frames, offsets, it, factors, f64::INFINITY)
-}
-
-/// For tests: the factorisations of the Newton system made to fail, as rounding makes them fail where an
-/// active row's weight swamps the rest.
-#[cfg(test)]
-mod forced_failure {
-    use std::cell::Cell;
-
-    thread_local! {
-        static LEFT: Cell<Option<u32>> = const { Cell::new(None) };
-    }
-
-    /// Every factorisation after the next `n` fails (`None`: none does).
-    pub(super) fn after(n: Option<u32>) {
-        LEFT.with(|left| left.set(n));
-    }
-
-    /// Whether this factorisation fails.
-    pub(super) fn now() -> bool {
-        LEFT.with(|left| match left.get() {
-            Some(0) => true,
-            Some(n) => {
-                left.set(Some(n - 1));
-                false
-            }
-            None => false,
-        })
-    }
 }
 
 /// [`factorised`] with every row's weight `lambda / t` capped at `weight_cap`.
@@ -1272,39 +1213,6 @@ mod tests {
             .flat_map(|f| f[1])
             .fold(0.0_f64, |m, g| m.max(g.abs()));
         assert!(c_fed < 1e-6, "{feedback:?}");
-    }
-
-    #[test]
-    fn a_factorisation_failing_at_an_almost_solved_iterate_gives_that_iterate_almost_solved() {
-        let (sp, layout) = walled_chain();
-        let rhs = [0.5; 3];
-        let problem = StagedProblem::new(&sp, &layout, &rhs);
-        let solved = |fail_after: Option<u32>| {
-            forced_failure::after(fail_after);
-            let solved = solve(&problem, 100, 10.0, None);
-            forced_failure::after(None);
-            solved
-        };
-        let full = match solved(None) {
-            Ok(full) => full,
-            Err(not) => panic!("{not:?}"),
-        };
-        assert!(!full.almost && full.iterations > 2, "{}", full.iterations);
-        // One factorisation starts the iterate, one per iteration after: the last iteration's fails,
-        // where the iterate is within the looser tolerances.
-        let last_failed = solved(Some(full.iterations));
-        let almost = last_failed
-            .as_ref()
-            .map(|s| (s.almost, s.iterations))
-            .map_err(|e| format!("{e:?}"));
-        assert_eq!(almost, Ok((true, full.iterations - 1)));
-        // The objective is the progress along x, the last frame's state change `px`; the sides, which
-        // move y under a wall that binds nothing, are free in the interior of their boxes.
-        let progress = |x: &[f64]| x[layout.ix(2, 0)];
-        let short = last_failed.map_or(f64::INFINITY, |s| progress(&full.x) - progress(&s.x));
-        assert!((0.0..1e-6).contains(&short), "{short}");
-        // Far from the solution a failed factorisation gives none.
-        assert_eq!(solved(Some(2)).err(), Some(NotStaged::Numerics));
     }
 
     #[test]
