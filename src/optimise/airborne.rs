@@ -661,10 +661,11 @@ struct Seed<'t> {
 /// racing line's run can be faster. (A run that touches a wall is no start: the model, which has no
 /// collisions, leaves the corridor at the contact and the stage stalls there.)
 fn greedy_beside_the_seed(base: &Baseline) -> Option<&Trace> {
-    let greedy = &base.greedy.trace;
-    let crossing = greedy.crossing?;
-    let seed_s = base.seed().crossing.map(|c| c.time);
-    (is_clean(greedy) && seed_s != Some(crossing.time)).then_some(greedy)
+    // Without clean runs the seed is the greedy run itself.
+    let seed_guide = base.clean.first().map(|run| run.guide);
+    let greedy = &base.greedy;
+    (is_clean(&greedy.trace) && seed_guide.is_some_and(|guide| guide != greedy.guide))
+        .then_some(&greedy.trace)
 }
 
 /// The relaxed line from the seed; where it finds none, or one that crosses after the greedy run, also
@@ -680,10 +681,10 @@ fn relaxed_line(
 ) -> Option<Vec<FrameControl>> {
     let Seed { warm, n, greedy } = seed;
     let line = relaxed_plan(planner, progress, warm, n, lo, planning, Descent::PLAN).line;
-    let line_s = crossing_s(planner, line.as_deref());
-    let Some((greedy, crossing)) = greedy.and_then(|g| Some((g, g.crossing?))) else {
+    let Some((greedy, crossing)) = greedy.and_then(|g| g.crossing.map(|c| (g, c))) else {
         return line;
     };
+    let line_s = crossing_s(planner, line.as_deref());
     if line_s <= crossing.time || planner.out_of_time() {
         return line;
     }
@@ -932,6 +933,7 @@ pub(super) fn kept_if_faster(best: &mut BestPlan, greedy_s: f64, t: f64, trace: 
 mod tests {
     use super::*;
     use crate::budget::Budget;
+    use crate::optimise::baseline::GuideRun;
     use crate::optimise::planner::{planning_inputs, staircase_scene, with_fast_planner};
     use crate::optimise::search::SearchSettings;
     use crate::optimise::verify::time_of;
@@ -1073,6 +1075,25 @@ mod tests {
             assert!(crossing_s(planner, own.as_deref()) < greedy_s);
             assert!(own == line_of(planner, &seed, Some(greedy)));
         });
+    }
+
+    #[test]
+    fn the_greedy_run_is_descended_from_beside_the_seed_only_where_it_is_another_run() {
+        let (_, _, base) = planning_inputs(&staircase_scene(1));
+        assert!(base.clean.len() > 1, "no second clean greedy run");
+        let with_greedy = |greedy: &GuideRun, clean: &[GuideRun]| Baseline {
+            greedy: greedy.clone(),
+            clean: clean.to_vec(),
+        };
+        let other = with_greedy(&base.clean[1], &base.clean);
+        assert!(
+            greedy_beside_the_seed(&other).is_some_and(|t| std::ptr::eq(t, &other.greedy.trace))
+        );
+        let seed = with_greedy(&base.clean[0], &base.clean);
+        assert!(greedy_beside_the_seed(&seed).is_none());
+        // With no clean run the greedy run is the seed.
+        let alone = with_greedy(&base.clean[1], &[]);
+        assert!(greedy_beside_the_seed(&alone).is_none());
     }
 
     #[test]
