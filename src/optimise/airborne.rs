@@ -1097,6 +1097,49 @@ mod tests {
     }
 
     #[test]
+    fn a_plan_ahead_of_the_certificate_is_its_start_beside_another_lines_rounding() {
+        // The plan so far is the greedy run, and the certificate has no line yet: the plan is ahead of
+        // it, so while another line is rounded, the plan is solved as the certificate's start on a fork
+        // beside it. The other line here is empty and rounds into no plan, so the plan is not a start
+        // again after it: the certificate's one start is the fork's. The certificate is then no slower
+        // than the plan, and its line is returned to be rounded in turn.
+        with_fast_planner(&staircase_scene(1), |planner, base, bound| {
+            let greedy = base.greedy.trace.clone();
+            let greedy_s = time_of(&greedy);
+            let terms = PlanTerms {
+                lo: (bound.crossing.frames as usize).saturating_sub(1),
+                planning_margin: planning_margin(planner),
+                greedy_s,
+            };
+            let mut best: BestPlan = Some((greedy_s, greedy));
+            let mut certifier = Certifier::default();
+            let line = Vec::new();
+            let faster_line = another_line_beside_the_plan_as_start(
+                planner,
+                &mut certifier,
+                line,
+                terms,
+                &mut |_| {},
+                &mut best,
+            );
+            let certificate = certifier
+                .certificate()
+                .unwrap_or_else(|| panic!("the plan was not solved as a start"));
+            assert_eq!(certificate.starts, 1);
+            let Some((plan_s, _)) = best else {
+                panic!("no plan")
+            };
+            assert_eq!(plan_s, greedy_s, "a plan of the rounding was kept");
+            assert!(
+                certificate.time <= plan_s,
+                "certificate {certificate:?} behind the plan's {plan_s} s"
+            );
+            let faster_line = faster_line.unwrap_or_else(|| panic!("no line returned"));
+            assert!(certifier.best().is_some_and(|p| p.controls == faster_line));
+        });
+    }
+
+    #[test]
     fn where_the_seed_gives_no_relaxed_line_a_greedy_starts_line_is_rounded() {
         // An empty seed: the relaxed stage grows it a few frames at a time and never reaches the line.
         // The certificate's greedy start (the second clean greedy run) does, and its line is the plan's.

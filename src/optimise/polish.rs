@@ -299,6 +299,7 @@ fn resolved_wider(
 mod tests {
     use super::*;
     use crate::optimise::planner::{staircase_scene, with_fast_planner};
+    use crate::optimise::rounding::round_sides_trimmed;
     use crate::optimise::verify::replay_drift;
     use crate::scene::generate::{generate, GeneratorSettings};
     use crate::scene::Scene;
@@ -457,12 +458,17 @@ mod tests {
         // The staircase at 100 fps with air acceleration 10: gamma1 = 32 > L = 30, the law's second
         // case, whose kink (c = -2 ups) is the frame of the largest turn. The relaxed line turns its
         // corner on such frames; rounded and polished, the plan that may turn less ends with none of them
-        // inside the band the game's yaw cannot resolve, and with some at its bottom edge.
+        // inside the band the game's yaw cannot resolve, and with some at its bottom edge. The sides
+        // are rounded at the relaxed `c`, untrimmed (`round_sides` trims them on the straights), so
+        // that the frames on the kink are the relaxed line's own.
         on_a_fast_planner(&staircase_scene(1), |planner, warm| {
             let (fl, margin) = (planner.fl, planner.settings.margin_units);
             assert!(!fl.has_kink_guard());
             let relaxed = planner.stage(planner.problem(margin, true, 1), warm, 25).0;
-            let Some(sides) = rounded(planner, &relaxed, ROUNDING_HORIZONS_S[0]) else {
+            let horizon = ROUNDING_HORIZONS_S[0];
+            let untrimmed =
+                round_sides_trimmed(&planner.start, &relaxed, &fl, horizon, 0.0, &planner.budget);
+            let Some(sides) = untrimmed else {
                 panic!("no rounding")
             };
             let polished = polished(planner, sides, margin, StageKind::Plain);

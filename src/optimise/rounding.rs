@@ -22,6 +22,12 @@ const ON_TARGET_BISECTIONS: usize = 30;
 /// sub-problems put a side on its bound to their solver's tolerance (about `1e-8`); sides within a
 /// thousandth of it drift a path by at most a thousandth of a turn a frame.
 const SATURATED_SIDE: f64 = 1.0 - 1e-3;
+/// How far the rounding may trim a frame's `c` off the relaxed one, either way, where the relaxed side is
+/// inside its bounds: this share of `L` in the law's second case ([`trim_scale_ups`]; 0.9 ups), which
+/// turns a frame by about that share of its turn more or less ([`trimmed_frames`]). Its size is not
+/// tuned: shares of 0.01, 0.03 and 0.1 won the same frames on the CI-sized family of seed 11
+/// (docs/design.md, "Keeping the sides centred on a straight: trimmed frames").
+const PHASE_TRIM_SHARE: f64 = 0.03;
 
 /// Rounds relaxed sides to `+-1`: a beam search over side sequences that keeps the exact trajectory on the
 /// relaxed one. A sequence's cost adds, each frame, the squared cross-track error and the squared distance
@@ -34,7 +40,8 @@ const SATURATED_SIDE: f64 = 1.0 - 1e-3;
 /// At such a run and the frame before it, each sequence may also play the frame that turns onto the
 /// relaxed heading exactly ([`on_target_frame`]), paying once for the speed it gains otherwise, as the
 /// distance that puts it off the line by the end of the plan. A relaxed side counts as at its bound
-/// from [`SATURATED_SIDE`].
+/// from [`SATURATED_SIDE`]. Elsewhere it may play a frame trimmed a little ([`trimmed_frames`]), paying
+/// likewise: that keeps the alternating sides centred on the relaxed heading.
 /// `None` when `budget` runs out first.
 pub(super) fn round_sides(
     start: &ModelState,
@@ -43,11 +50,28 @@ pub(super) fn round_sides(
     horizon_s: f64,
     budget: &Budget,
 ) -> Option<Vec<FrameControl>> {
+    round_sides_trimmed(start, controls, fl, horizon_s, PHASE_TRIM_SHARE, budget)
+}
+
+/// [`round_sides`] with frames trimmed by `trim_share` of [`trim_scale_ups`] (0: none).
+pub(super) fn round_sides_trimmed(
+    start: &ModelState,
+    controls: &[FrameControl],
+    fl: &FrameLaw,
+    horizon_s: f64,
+    trim_share: f64,
+    budget: &Budget,
+) -> Option<Vec<FrameControl>> {
+    let trim_ups = trim_share * trim_scale_ups(fl);
     let relaxed = rollout(start, controls, fl);
     let frames = controls.len();
-    // Beam entries: (cost, state, index into the history of choices).
-    let mut history: Vec<(usize, FrameControl)> = Vec::with_capacity(frames * ROUNDING_BEAM * 3);
-    let mut beam: Vec<(f64, ModelState, usize)> = vec![(0.0, *start, usize::MAX)];
+    let mut history: Vec<(usize, FrameControl)> = Vec::with_capacity(frames * ROUNDING_BEAM * 6);
+    let mut beam = vec![Sequence {
+        cost: 0.0,
+        state: *start,
+        last: usize::MAX,
+        behind_units: 0.0,
+    }];
     let held_s = saturated_runs_s(controls, fl.tau_s);
     for (k, u) in controls.iter().enumerate() {
         if k as u64 % FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
@@ -56,47 +80,57 @@ pub(super) fn round_sides(
         let target = relaxed[k];
         let remaining_s = (frames - k - 1) as f64 * fl.tau_s;
         let normal = crate::physics::Vec2::from_angle(target.heading).perp();
-        let mut next: Vec<(f64, ModelState, usize)> = Vec::with_capacity(beam.len() * 3);
+        let mut next: Vec<Sequence> = Vec::with_capacity(beam.len() * 6);
         // The run of saturated sides the next frame starts or is in, seconds (0 if none); a frame
-        // that turns less is offered in such a run and the frame before it.
+        // that turns less is offered in such a run and the frame before it, a trimmed frame elsewhere.
         let next_run_s = held_s.get(k + 1).copied().unwrap_or(0.0);
         let saturated = held_s[k] > 0.0 || next_run_s > 0.0;
         let held = horizon_s.max(next_run_s);
-        for &(cost, x, h) in &beam {
+        for seq in &beam {
+            let x = seq.state;
             let sides = [1.0, -1.0].map(|sigma| (FrameControl { sigma, c: u.c }, false));
             let on_target = saturated
                 .then(|| on_target_frame(&x, target.heading, u.c, fl))
                 .flatten()
                 .map(|v| (v, true));
-            for (choice, turns_less) in sides.into_iter().chain(on_target) {
+            let trimmed = (!saturated)
+                .then(|| trimmed_frames(&x, *u, trim_ups, fl))
+                .into_iter()
+                .flatten()
+                .map(|v| (v, true));
+            for (choice, pays_speed) in sides.into_iter().chain(on_target).chain(trimmed) {
                 let y = frame(&x, choice, fl, false).0;
-                // Cross-track error only: every side sequence falls behind the relaxed line along the
-                // track alike (the zigzag of alternating sides shortens each move by about
-                // 1 - cos(delta / 2)), which the polish of `c` then trades off.
+                // Across the track and the heading only: the zigzag of alternating sides shortens
+                // each move along the track by about `1 - cos(e)` of a heading error `e`, which the
+                // heading's term weighs too.
                 let cross = (y.pos - target.pos).dot(normal);
                 let drift = (y.heading - target.heading) * y.speed * held;
-                // A frame that turns less pays once for the speed it gains otherwise than the relaxed
-                // frame, as the distance that puts it off the line by the end of the plan. Sides of
-                // `+-1` at the relaxed `c` gain what it gains (`V'` does not depend on the side).
-                let behind = if turns_less {
-                    (frame(&x, *u, fl, false).0.speed - y.speed) * remaining_s
+                // A frame that turns less, or is trimmed, gives up speed against the relaxed frame,
+                // which by the end of the plan puts the sequence that distance behind the line; the
+                // cost carries the square of that distance, summed over the sequence's frames (many
+                // small trims add up as one large one). Sides of `+-1` at the relaxed `c` gain what
+                // it gains (`V'` does not depend on the side).
+                let behind_units = if pays_speed {
+                    seq.behind_units + (frame(&x, *u, fl, false).0.speed - y.speed) * remaining_s
                 } else {
-                    0.0
+                    seq.behind_units
                 };
-                history.push((h, choice));
-                next.push((
-                    cost + cross * cross + drift * drift + behind * behind,
-                    y,
-                    history.len() - 1,
-                ));
+                history.push((seq.last, choice));
+                next.push(Sequence {
+                    cost: seq.cost + cross * cross + drift * drift + behind_units * behind_units
+                        - seq.behind_units * seq.behind_units,
+                    state: y,
+                    last: history.len() - 1,
+                    behind_units,
+                });
             }
         }
-        next.sort_by(|a, b| a.0.total_cmp(&b.0));
+        next.sort_by(|a, b| a.cost.total_cmp(&b.cost));
         next.truncate(ROUNDING_BEAM);
         beam = next;
     }
     let mut rounded = Vec::with_capacity(frames);
-    let mut h = beam.first().map_or(usize::MAX, |b| b.2);
+    let mut h = beam.first().map_or(usize::MAX, |b| b.last);
     while h != usize::MAX {
         let (parent, u) = history[h];
         rounded.push(u);
@@ -104,6 +138,34 @@ pub(super) fn round_sides(
     }
     rounded.reverse();
     Some(rounded)
+}
+
+/// The `c` a trim is a share of, ups: `L` in the law's second case (`gamma1 > L`), where the maximum
+/// acceleration is at `c = 0` and the speed gained, `V'^2 = V^2 + L^2 - c^2`, is stationary there, so a
+/// trim gives up only the square of its size; zero in the first, where the maximum acceleration is at the
+/// law's kink and a trim either way gives up speed in proportion to its size (`2 gamma1` of `V'^2` an ups
+/// below the kink), which the heading it sets back does not repay (a straight at 250 fps from 200 ups,
+/// trimmed, ended five times further behind its relaxed line than with the relaxed `c`).
+fn trim_scale_ups(fl: &FrameLaw) -> f64 {
+    if fl.law.gamma1 > fl.law.l {
+        fl.law.l
+    } else {
+        0.0
+    }
+}
+
+/// A side sequence of the rounding's beam.
+#[derive(Clone, Copy)]
+struct Sequence {
+    /// Its cost so far (see [`round_sides`]).
+    cost: f64,
+    /// The state after its last frame.
+    state: ModelState,
+    /// Its last choice's index in the beam's history (`usize::MAX`: none yet).
+    last: usize,
+    /// How far behind the relaxed line the speed its frames gave up puts it by the end of the plan,
+    /// units.
+    behind_units: f64,
 }
 
 /// Per frame, how long from it the relaxed sides stay at their bound, seconds (0 where they are not):
@@ -120,6 +182,30 @@ fn saturated_runs_s(controls: &[FrameControl], tau_s: f64) -> Vec<f64> {
         held[k] = run;
     }
     held
+}
+
+/// The frames from `x` with the relaxed control `u`'s `c` trimmed by `trim_ups` either way, on either
+/// side, within the `c` a plan with exact sides may use (from [`FrameLaw::c_min`] to
+/// [`FrameLaw::c_exact_max`]). Sides of `+-1` at one `c` swing the heading a turn `delta` a frame, at best
+/// centred on the relaxed heading (`+-delta / 2`, each move `(delta / 2)^2 / 2` of its length short), at
+/// worst with one move on it (`0` and `delta`: twice the loss). `delta` falls as the speed rises (about
+/// `min(L, gamma1) / V`), so a phase set once drifts off centre, and at the relaxed `c` the sides can take
+/// it back only by playing one side twice, which swings the heading `3 delta / 2` off for a frame. A
+/// trimmed frame turns by about `trim_ups / V` more or less, and in the law's second case, off the
+/// maximum-acceleration `c = 0`, gains `V'^2 = V^2 + L^2 - c^2`: the speed it gives up grows as the square
+/// of the trim, so a phase taken back over many small trims costs less than over few large ones.
+/// Empty for a trim of zero.
+fn trimmed_frames(
+    x: &ModelState,
+    u: FrameControl,
+    trim_ups: f64,
+    fl: &FrameLaw,
+) -> impl Iterator<Item = FrameControl> {
+    let (lo, hi) = (fl.c_min(x.speed), fl.c_exact_max(x.speed));
+    [u.c + trim_ups, u.c - trim_ups]
+        .into_iter()
+        .filter(move |c| trim_ups > 0.0 && (lo..=hi).contains(c))
+        .flat_map(|c| [1.0, -1.0].map(|sigma| FrameControl { sigma, c }))
 }
 
 /// The frame from `x` that turns the heading onto `heading` exactly, when a frame that turns less than the
@@ -252,6 +338,95 @@ mod tests {
         }
     }
 
+    /// The rounding of a straight of relaxed sides `0` from `v` ups, `frames` long, under the frame law
+    /// `fl` with the frames trimmed by `trim_share`: how far the rounded path ends behind the relaxed one along the
+    /// track, and its largest distance across it, units.
+    fn straight_rounded(fl: &FrameLaw, v: f64, frames: usize, trim_share: f64) -> (f64, f64) {
+        let fl = *fl;
+        let x0 = start(v);
+        let controls = straight(&fl, v, frames);
+        let relaxed = rollout(&x0, &controls, &fl);
+        let rounded = round_sides_trimmed(
+            &x0,
+            &controls,
+            &fl,
+            ROUNDING_HORIZON_S,
+            trim_share,
+            &Budget::unlimited(),
+        )
+        .unwrap_or_else(|| panic!("the unlimited budget ran out"));
+        assert!(rounded.iter().all(|u| u.sigma.abs() == 1.0));
+        let played = rollout(&x0, &rounded, &fl);
+        let across = most_across(&relaxed, &played);
+        let (r, p) = (relaxed[frames - 1], played[frames - 1]);
+        ((r.pos - p.pos).dot(Vec2::from_angle(r.heading)), across)
+    }
+
+    /// The farthest the `played` path is across the track from the `relaxed` one, frame by frame, units.
+    fn most_across(relaxed: &[ModelState], played: &[ModelState]) -> f64 {
+        relaxed
+            .iter()
+            .zip(played)
+            .map(|(r, p)| {
+                (p.pos - r.pos)
+                    .dot(Vec2::from_angle(r.heading).perp())
+                    .abs()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// `frames` frames of relaxed side `0` at the maximum-acceleration `c`, from `v` ups.
+    fn straight(fl: &FrameLaw, v: f64, frames: usize) -> Vec<FrameControl> {
+        let mut x = start(v);
+        (0..frames)
+            .map(|_| {
+                let u = FrameControl {
+                    sigma: 0.0,
+                    c: fl.c_plan_max(x.speed),
+                };
+                x = frame(&x, u, fl, false).0;
+                u
+            })
+            .collect()
+    }
+
+    #[test]
+    fn trimmed_frames_keep_the_sides_centred_on_a_straight_as_the_turn_shrinks() {
+        // From 80 ups at 100 fps a frame turns 0.36 rad, and by 300 frames (about 520 ups) 0.06: the
+        // phase of alternating sides drifts off centre all the way. 100 fps with air acceleration 10,
+        // and 250 fps with 100, are the law's second case.
+        for (fps, aa100, v, frames) in [(100.0, false, 80.0, 300), (250.0, true, 200.0, 500)] {
+            let mut fl = law(fps);
+            if aa100 {
+                fl.law.gamma1 *= 10.0;
+            }
+            assert!(fl.law.gamma1 > fl.law.l);
+            let controls = straight(&fl, v, frames);
+            let x0 = start(v);
+            let end = rollout(&x0, &controls, &fl)[frames - 1];
+            let zigzag_units =
+                super::super::relaxed::zigzag_frames(&x0, &controls, &fl) * end.speed * fl.tau_s;
+            let (trimmed, across) = straight_rounded(&fl, v, frames, PHASE_TRIM_SHARE);
+            let (fixed, _) = straight_rounded(&fl, v, frames, 0.0);
+            // Untrimmed, the sides end twice the zigzag's estimate behind (one move of each pair on
+            // the relaxed heading); trimmed, a tenth closer at least, never ahead of the estimate (the
+            // least any sides can lose), and still on the line across the track.
+            assert!(
+                trimmed < 0.9 * fixed && trimmed > 0.9 * zigzag_units,
+                "{fps} fps: {trimmed} units behind trimmed, {fixed} untrimmed, estimate {zigzag_units}"
+            );
+            assert!(across < 1.0, "{fps} fps: {across} units across");
+        }
+        // In the law's first case (250 fps, air acceleration 10) no frame is trimmed: the same sides.
+        let fl = law(250.0);
+        assert!(fl.law.gamma1 < fl.law.l);
+        let untrimmed = straight_rounded(&fl, 200.0, 500, 0.0);
+        assert_eq!(
+            straight_rounded(&fl, 200.0, 500, PHASE_TRIM_SHARE),
+            untrimmed
+        );
+    }
+
     #[test]
     fn the_rounded_sides_meet_a_turn_at_the_bound_in_phase() {
         // 250 fps, 450 ups: a 60-frame turn after a 200-frame straight and a half-turn frame. Sides of
@@ -270,15 +445,7 @@ mod tests {
         )
         .unwrap_or_else(|| panic!("the unlimited budget ran out"));
         let played = rollout(&x0, &rounded, &fl);
-        let worst = relaxed
-            .iter()
-            .zip(&played)
-            .map(|(r, p)| {
-                (p.pos - r.pos)
-                    .dot(Vec2::from_angle(r.heading).perp())
-                    .abs()
-            })
-            .fold(0.0, f64::max);
+        let worst = most_across(&relaxed, &played);
         assert!(
             worst < 0.15,
             "the rounded path is {worst} units off the relaxed one"
