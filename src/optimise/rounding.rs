@@ -88,6 +88,9 @@ pub(super) fn round_sides_trimmed(
         let held = horizon_s.max(next_run_s);
         for seq in &beam {
             let x = seq.state;
+            // The speed the relaxed frame reaches, which sides of `+-1` at the relaxed `c` reach too
+            // (`V'` does not depend on the side): asked for once, by the first frame that pays.
+            let mut relaxed_speed = None;
             let sides = [1.0, -1.0].map(|sigma| (FrameControl { sigma, c: u.c }, false));
             let on_target = saturated
                 .then(|| on_target_frame(&x, target.heading, u.c, fl))
@@ -108,10 +111,11 @@ pub(super) fn round_sides_trimmed(
                 // A frame that turns less, or is trimmed, gives up speed against the relaxed frame,
                 // which by the end of the plan puts the sequence that distance behind the line; the
                 // cost carries the square of that distance, summed over the sequence's frames (many
-                // small trims add up as one large one). Sides of `+-1` at the relaxed `c` gain what
-                // it gains (`V'` does not depend on the side).
+                // small trims add up as one large one).
                 let behind_units = if pays_speed {
-                    seq.behind_units + (frame(&x, *u, fl, false).0.speed - y.speed) * remaining_s
+                    let relaxed_speed =
+                        *relaxed_speed.get_or_insert_with(|| frame(&x, *u, fl, false).0.speed);
+                    seq.behind_units + (relaxed_speed - y.speed) * remaining_s
                 } else {
                     seq.behind_units
                 };
@@ -125,8 +129,11 @@ pub(super) fn round_sides_trimmed(
                 });
             }
         }
+        if next.len() > ROUNDING_BEAM {
+            next.select_nth_unstable_by(ROUNDING_BEAM, |a, b| a.cost.total_cmp(&b.cost));
+            next.truncate(ROUNDING_BEAM);
+        }
         next.sort_by(|a, b| a.cost.total_cmp(&b.cost));
-        next.truncate(ROUNDING_BEAM);
         beam = next;
     }
     let mut rounded = Vec::with_capacity(frames);
