@@ -65,7 +65,8 @@ pub(super) fn round_sides_trimmed(
     let trim_ups = trim_share * trim_scale_ups(fl);
     let relaxed = rollout(start, controls, fl);
     let frames = controls.len();
-    let mut history: Vec<(usize, FrameControl)> = Vec::with_capacity(frames * ROUNDING_BEAM * 6);
+    // The kept sequences' choices, each with the index of the choice before it.
+    let mut history: Vec<(usize, FrameControl)> = Vec::with_capacity(frames * ROUNDING_BEAM);
     let mut beam = vec![Sequence {
         cost: 0.0,
         state: *start,
@@ -80,29 +81,31 @@ pub(super) fn round_sides_trimmed(
         let target = relaxed[k];
         let remaining_s = (frames - k - 1) as f64 * fl.tau_s;
         let normal = crate::physics::Vec2::from_angle(target.heading).perp();
-        let mut next: Vec<Sequence> = Vec::with_capacity(beam.len() * 6);
+        // Each sequence one frame on, with its last choice (its `last` still its parent's).
+        let mut next: Vec<(Sequence, FrameControl)> = Vec::with_capacity(beam.len() * 6);
         // The run of saturated sides the next frame starts or is in, seconds (0 if none); a frame
         // that turns less is offered in such a run and the frame before it, a trimmed frame elsewhere.
         let next_run_s = held_s.get(k + 1).copied().unwrap_or(0.0);
         let saturated = held_s[k] > 0.0 || next_run_s > 0.0;
         let held = horizon_s.max(next_run_s);
+        let trim = if saturated { 0.0 } else { trim_ups };
         for seq in &beam {
             let x = seq.state;
-            // The speed the relaxed frame reaches, which sides of `+-1` at the relaxed `c` reach too
-            // (`V'` does not depend on the side): asked for once, by the first frame that pays.
-            let mut relaxed_speed = None;
-            let sides = [1.0, -1.0].map(|sigma| (FrameControl { sigma, c: u.c }, false));
+            let sides = [1.0, -1.0].map(|sigma| {
+                let choice = FrameControl { sigma, c: u.c };
+                (choice, frame(&x, choice, fl, false).0, false)
+            });
+            // Sides of `+-1` at the relaxed `c` reach the relaxed frame's speed (`V'` does not depend
+            // on the side).
+            let relaxed_speed = sides[0].1.speed;
             let on_target = saturated
                 .then(|| on_target_frame(&x, target.heading, u.c, fl))
-                .flatten()
-                .map(|v| (v, true));
-            let trimmed = (!saturated)
-                .then(|| trimmed_frames(&x, *u, trim_ups, fl))
+                .flatten();
+            let paying = on_target
                 .into_iter()
-                .flatten()
-                .map(|v| (v, true));
-            for (choice, pays_speed) in sides.into_iter().chain(on_target).chain(trimmed) {
-                let y = frame(&x, choice, fl, false).0;
+                .chain(trimmed_frames(&x, *u, trim, fl))
+                .map(|choice| (choice, frame(&x, choice, fl, false).0, true));
+            for (choice, y, pays_speed) in sides.into_iter().chain(paying) {
                 // Across the track and the heading only: the zigzag of alternating sides shortens
                 // each move along the track by about `1 - cos(e)` of a heading error `e`, which the
                 // heading's term weighs too.
@@ -113,28 +116,39 @@ pub(super) fn round_sides_trimmed(
                 // cost carries the square of that distance, summed over the sequence's frames (many
                 // small trims add up as one large one).
                 let behind_units = if pays_speed {
-                    let relaxed_speed =
-                        *relaxed_speed.get_or_insert_with(|| frame(&x, *u, fl, false).0.speed);
                     seq.behind_units + (relaxed_speed - y.speed) * remaining_s
                 } else {
                     seq.behind_units
                 };
-                history.push((seq.last, choice));
-                next.push(Sequence {
-                    cost: seq.cost + cross * cross + drift * drift + behind_units * behind_units
-                        - seq.behind_units * seq.behind_units,
+                let cost = seq.cost + cross * cross + drift * drift + behind_units * behind_units
+                    - seq.behind_units * seq.behind_units;
+                let extended = Sequence {
+                    cost,
                     state: y,
-                    last: history.len() - 1,
+                    last: seq.last,
                     behind_units,
-                });
+                };
+                next.push((extended, choice));
             }
         }
+        let by_cost = |a: &(Sequence, FrameControl), b: &(Sequence, FrameControl)| {
+            a.0.cost.total_cmp(&b.0.cost)
+        };
         if next.len() > ROUNDING_BEAM {
-            next.select_nth_unstable_by(ROUNDING_BEAM, |a, b| a.cost.total_cmp(&b.cost));
+            next.select_nth_unstable_by(ROUNDING_BEAM, by_cost);
             next.truncate(ROUNDING_BEAM);
         }
-        next.sort_by(|a, b| a.cost.total_cmp(&b.cost));
-        beam = next;
+        next.sort_by(by_cost);
+        beam = next
+            .into_iter()
+            .map(|(seq, choice)| {
+                history.push((seq.last, choice));
+                Sequence {
+                    last: history.len() - 1,
+                    ..seq
+                }
+            })
+            .collect();
     }
     let mut rounded = Vec::with_capacity(frames);
     let mut h = beam.first().map_or(usize::MAX, |b| b.last);
@@ -154,10 +168,10 @@ pub(super) fn round_sides_trimmed(
 /// below the kink), which the heading it sets back does not repay (a straight at 250 fps from 200 ups,
 /// trimmed, ended five times further behind its relaxed line than with the relaxed `c`).
 fn trim_scale_ups(fl: &FrameLaw) -> f64 {
-    if fl.law.gamma1 > fl.law.l {
-        fl.law.l
-    } else {
+    if fl.has_kink_guard() {
         0.0
+    } else {
+        fl.law.l
     }
 }
 
