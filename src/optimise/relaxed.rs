@@ -279,9 +279,7 @@ pub(super) fn count_search<'a>(
         frames_per_knot,
         grow_tries: max_grow_tries,
     } = search;
-    let problem = |p: &Planner<'a>| relaxed_problem(p, relaxation, frames_per_knot);
     let fl = planner.fl;
-    let relaxed_iters = planner.settings.relaxed_iters;
     let max_returns = planner.settings.capped_line_returns;
     // A sub-problem has at least one step to plan (an empty one is no problem for the solver).
     n = n.max(1);
@@ -304,20 +302,13 @@ pub(super) fn count_search<'a>(
                 c: fl.c_max(f64::INFINITY),
             },
         );
-        planner.stats.frame_counts_tried += 1;
-        let pr = problem(planner);
-        let (c, capped) = planner.stage(pr, controls.clone(), relaxed_iters);
-        planner.note_cut(Stage::Relaxed);
-        let states = rollout_knots(&planner.start, &c, &fl, frames_per_knot);
-        let reached = model_crossing(&planner.start, &states, planner.scene);
-        let clean = problem(planner).violation(&states) <= super::scp::CLEAN_VIOLATION_UNITS;
-        let per = frames_per_knot as usize;
-        progress(Progress::FrameCount {
-            frames: n * per,
-            reached: reached.filter(|_| clean).map(|k| k * per),
-        });
-        match reached {
-            Some(k) if clean => {
+        let CountTried {
+            controls: c,
+            capped,
+            crossing,
+        } = stage_at_count(planner, progress, &controls, relaxation, frames_per_knot);
+        match crossing {
+            Some(k) => {
                 best = Some(c[..k].to_vec());
                 best_capped = capped;
                 // One step short of this plan's crossing, warm-started from it: each solve keeps
@@ -360,6 +351,45 @@ pub(super) fn count_search<'a>(
         }
     };
     Descended { line: best, short }
+}
+
+/// One count of a count search: the plan its stage ended with, whether the stage stopped at its
+/// iteration cap, and the step its plan crosses the finish line in when it does so clear of the walls.
+struct CountTried {
+    controls: Vec<FrameControl>,
+    capped: bool,
+    crossing: Option<usize>,
+}
+
+/// The relaxed problem's SCP stage over the planning steps of `controls` (steps of `frames_per_knot`
+/// frames), reported to `progress`.
+fn stage_at_count(
+    planner: &mut Planner,
+    progress: &mut dyn FnMut(Progress),
+    controls: &[FrameControl],
+    relaxation: Relaxation,
+    frames_per_knot: u32,
+) -> CountTried {
+    planner.stats.frame_counts_tried += 1;
+    let relaxed_iters = planner.settings.relaxed_iters;
+    let pr = relaxed_problem(planner, relaxation, frames_per_knot);
+    let (c, capped) = planner.stage(pr, controls.to_vec(), relaxed_iters);
+    planner.note_cut(Stage::Relaxed);
+    let states = rollout_knots(&planner.start, &c, &planner.fl, frames_per_knot);
+    let reached = model_crossing(&planner.start, &states, planner.scene);
+    let problem = relaxed_problem(planner, relaxation, frames_per_knot);
+    let clean = problem.violation(&states) <= super::scp::CLEAN_VIOLATION_UNITS;
+    let crossing = reached.filter(|_| clean);
+    let per = frames_per_knot as usize;
+    progress(Progress::FrameCount {
+        frames: controls.len() * per,
+        reached: crossing.map(|k| k * per),
+    });
+    CountTried {
+        controls: c,
+        capped,
+        crossing,
+    }
 }
 
 /// The SCP problem of `relaxation` over planning steps of `frames_per_knot` frames.

@@ -78,17 +78,19 @@ pub(super) fn round_sides_trimmed(
         if k as u64 % FRAMES_PER_BUDGET_CHECK == 0 && budget.expired() {
             return None;
         }
-        let target = relaxed[k];
-        let remaining_s = (frames - k - 1) as f64 * fl.tau_s;
-        let normal = crate::physics::Vec2::from_angle(target.heading).perp();
-        // Each sequence one frame on, with its last choice (its `last` still its parent's).
-        let mut next: Vec<(Sequence, FrameControl)> = Vec::with_capacity(beam.len() * 6);
         // The run of saturated sides the next frame starts or is in, seconds (0 if none); a frame
         // that turns less is offered in such a run and the frame before it, a trimmed frame elsewhere.
         let next_run_s = held_s.get(k + 1).copied().unwrap_or(0.0);
         let saturated = held_s[k] > 0.0 || next_run_s > 0.0;
-        let held = horizon_s.max(next_run_s);
+        let target = Target {
+            relaxed: relaxed[k],
+            normal: crate::physics::Vec2::from_angle(relaxed[k].heading).perp(),
+            held_s: horizon_s.max(next_run_s),
+            remaining_s: (frames - k - 1) as f64 * fl.tau_s,
+        };
         let trim = if saturated { 0.0 } else { trim_ups };
+        // Each sequence one frame on, with its last choice (its `last` still its parent's).
+        let mut next: Vec<(Sequence, FrameControl)> = Vec::with_capacity(beam.len() * 6);
         for seq in &beam {
             let x = seq.state;
             let sides = [1.0, -1.0].map(|sigma| {
@@ -99,66 +101,93 @@ pub(super) fn round_sides_trimmed(
             // on the side).
             let relaxed_speed = sides[0].1.speed;
             let on_target = saturated
-                .then(|| on_target_frame(&x, target.heading, u.c, fl))
+                .then(|| on_target_frame(&x, target.relaxed.heading, u.c, fl))
                 .flatten();
             let paying = on_target
                 .into_iter()
                 .chain(trimmed_frames(&x, *u, trim, fl))
                 .map(|choice| (choice, frame(&x, choice, fl, false).0, true));
             for (choice, y, pays_speed) in sides.into_iter().chain(paying) {
-                // Across the track and the heading only: the zigzag of alternating sides shortens
-                // each move along the track by about `1 - cos(e)` of a heading error `e`, which the
-                // heading's term weighs too.
-                let cross = (y.pos - target.pos).dot(normal);
-                let drift = (y.heading - target.heading) * y.speed * held;
-                // A frame that turns less, or is trimmed, gives up speed against the relaxed frame,
-                // which by the end of the plan puts the sequence that distance behind the line; the
-                // cost carries the square of that distance, summed over the sequence's frames (many
-                // small trims add up as one large one).
-                let behind_units = if pays_speed {
-                    seq.behind_units + (relaxed_speed - y.speed) * remaining_s
-                } else {
-                    seq.behind_units
-                };
-                let cost = seq.cost + cross * cross + drift * drift + behind_units * behind_units
-                    - seq.behind_units * seq.behind_units;
-                let extended = Sequence {
-                    cost,
-                    state: y,
-                    last: seq.last,
-                    behind_units,
-                };
+                let extended = seq.extended(y, pays_speed.then_some(relaxed_speed), &target);
                 next.push((extended, choice));
             }
         }
-        let by_cost = |a: &(Sequence, FrameControl), b: &(Sequence, FrameControl)| {
-            a.0.cost.total_cmp(&b.0.cost)
-        };
-        if next.len() > ROUNDING_BEAM {
-            next.select_nth_unstable_by(ROUNDING_BEAM, by_cost);
-            next.truncate(ROUNDING_BEAM);
-        }
-        next.sort_by(by_cost);
-        beam = next
-            .into_iter()
-            .map(|(seq, choice)| {
-                history.push((seq.last, choice));
-                Sequence {
-                    last: history.len() - 1,
-                    ..seq
-                }
-            })
-            .collect();
+        beam = kept(next, &mut history);
     }
-    let mut rounded = Vec::with_capacity(frames);
-    let mut h = beam.first().map_or(usize::MAX, |b| b.last);
+    Some(traced_back(beam.first(), &history))
+}
+
+/// What a frame's choices are judged against: the relaxed line's state after the frame, the normal of
+/// its heading, how long a heading error is held ([`round_sides`]) and the plan's time left after it.
+struct Target {
+    relaxed: ModelState,
+    normal: crate::physics::Vec2,
+    held_s: f64,
+    remaining_s: f64,
+}
+
+impl Sequence {
+    /// This sequence one frame on to `y`, its cost grown by the frame's errors against `target`; a frame
+    /// that gives up speed against the relaxed frame's `relaxed_speed` (ups) pays for it too.
+    fn extended(&self, y: ModelState, relaxed_speed: Option<f64>, target: &Target) -> Sequence {
+        // Across the track and the heading only: the zigzag of alternating sides shortens each move
+        // along the track by about `1 - cos(e)` of a heading error `e`, which the heading's term weighs
+        // too.
+        let cross = (y.pos - target.relaxed.pos).dot(target.normal);
+        let drift = (y.heading - target.relaxed.heading) * y.speed * target.held_s;
+        // A frame that turns less, or is trimmed, gives up speed against the relaxed frame, which by the
+        // end of the plan puts the sequence that distance behind the line; the cost carries the square
+        // of that distance, summed over the sequence's frames (many small trims add up as one large one).
+        let behind_units = match relaxed_speed {
+            Some(v) => self.behind_units + (v - y.speed) * target.remaining_s,
+            None => self.behind_units,
+        };
+        let cost = self.cost + cross * cross + drift * drift + behind_units * behind_units
+            - self.behind_units * self.behind_units;
+        Sequence {
+            cost,
+            state: y,
+            last: self.last,
+            behind_units,
+        }
+    }
+}
+
+/// The [`ROUNDING_BEAM`] cheapest of `next` (each a sequence one frame on and its last choice), cheapest
+/// first, their choices added to `history`.
+fn kept(
+    mut next: Vec<(Sequence, FrameControl)>,
+    history: &mut Vec<(usize, FrameControl)>,
+) -> Vec<Sequence> {
+    let by_cost =
+        |a: &(Sequence, FrameControl), b: &(Sequence, FrameControl)| a.0.cost.total_cmp(&b.0.cost);
+    if next.len() > ROUNDING_BEAM {
+        next.select_nth_unstable_by(ROUNDING_BEAM, by_cost);
+        next.truncate(ROUNDING_BEAM);
+    }
+    next.sort_by(by_cost);
+    next.into_iter()
+        .map(|(seq, choice)| {
+            history.push((seq.last, choice));
+            Sequence {
+                last: history.len() - 1,
+                ..seq
+            }
+        })
+        .collect()
+}
+
+/// The choices of `best` from the first frame on, traced back through `history`.
+fn traced_back(best: Option<&Sequence>, history: &[(usize, FrameControl)]) -> Vec<FrameControl> {
+    let mut rounded = Vec::new();
+    let mut h = best.map_or(usize::MAX, |b| b.last);
     while h != usize::MAX {
         let (parent, u) = history[h];
         rounded.push(u);
         h = parent;
     }
     rounded.reverse();
-    Some(rounded)
+    rounded
 }
 
 /// The `c` a trim is a share of, ups: `L` in the law's second case (`gamma1 > L`), where the maximum

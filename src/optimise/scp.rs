@@ -540,14 +540,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let controls = unpack(&param);
         let trust = self.trust;
         let upper_at_kink = state.get_iter() % 2 == 0;
-        // The curvature is linear in the duals, and so is its convexification: scaling the duals scales
-        // the model's curvature.
-        let share = self.curvature_share;
-        let duals = self.duals.take().map(|z| {
-            z.into_iter()
-                .map(|zk| zk.map(|v| v * share))
-                .collect::<Vec<_>>()
-        });
+        let duals = self.duals_at_curvature_share();
         let seconds_left = self
             .budget
             .remaining()
@@ -595,13 +588,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
         let ratio = actual / step.predicted;
         let accepted = kept(actual, step.predicted);
         if accepted {
-            self.curvature_share = next_curvature_share(self.curvature_share, Some(ratio));
-            self.restored_last = false;
-            if ratio > GOOD_STEP_RATIO {
-                self.trust = doubled(self.trust);
-            } else if ratio < POOR_STEP_RATIO {
-                self.trust *= 0.5;
-            }
+            self.after_accepted_step(ratio);
             Ok((state.param(candidate).cost(new_cost), None))
         } else {
             if let Some((corrected, corrected_cost)) = self.second_order_correction(
@@ -621,9 +608,7 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
                     return Ok((state.param(corrected).cost(corrected_cost), None));
                 }
             }
-            self.stats.rejected_steps += 1;
-            self.curvature_share = next_curvature_share(self.curvature_share, None);
-            self.trust *= 0.3;
+            self.after_rejected_step();
             Ok((state, None))
         }
     }
@@ -647,6 +632,37 @@ impl<'a> Solver<ScpProblem<'a>, ScpState> for ScpSolver<'_> {
 }
 
 impl ScpSolver<'_> {
+    /// The last sub-problem's dynamics duals (taken: each is used once) scaled by the curvature's share.
+    /// The curvature is linear in the duals, and so is its convexification: scaling the duals scales
+    /// the model's curvature.
+    fn duals_at_curvature_share(&mut self) -> Option<Vec<[f64; 4]>> {
+        let share = self.curvature_share;
+        self.duals.take().map(|z| {
+            z.into_iter()
+                .map(|zk| zk.map(|v| v * share))
+                .collect::<Vec<_>>()
+        })
+    }
+
+    /// The trust region and the curvature's share after a step kept with `ratio` of its predicted gain:
+    /// the radius doubled after a good step, halved after a poor one.
+    fn after_accepted_step(&mut self, ratio: f64) {
+        self.curvature_share = next_curvature_share(self.curvature_share, Some(ratio));
+        self.restored_last = false;
+        if ratio > GOOD_STEP_RATIO {
+            self.trust = doubled(self.trust);
+        } else if ratio < POOR_STEP_RATIO {
+            self.trust *= 0.5;
+        }
+    }
+
+    /// The trust region and the curvature's share after a step rejected (its correction too).
+    fn after_rejected_step(&mut self) {
+        self.stats.rejected_steps += 1;
+        self.curvature_share = next_curvature_share(self.curvature_share, None);
+        self.trust *= 0.3;
+    }
+
     /// The warm start of `pr`'s next sub-problem: where the last one's solver ended, in the stages that
     /// take one ([`ScpProblem::warm_started`]).
     fn warm_start_for(&self, pr: &ScpProblem<'_>) -> Option<&qp::WarmStart> {
