@@ -16,9 +16,10 @@
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
-use super::airborne::{plan_airborne, plan_polished_finely};
+use super::airborne::{plan_airborne, plan_polished_finely, AirbornePlan};
 use super::baseline::{baseline, corner_caps, given_up_frame, GreedyGuide, GuideRun};
 use super::bound::{frame_limited_scene, lower_bound_within};
+use super::model::FrameControl;
 use super::planner::Planner;
 use super::qp::SubProblemSolver;
 use super::relaxed::{RelaxedCertificate, CERTIFICATE_MARGIN_UNITS};
@@ -589,20 +590,7 @@ fn solve_within(
         });
     }
     let mut planner = Planner::new(scene, &sim, settings, &bound, seed, budget);
-    let warm = planner.warm_start(seed);
-    let prefix_len = planner.prefix.len();
-    // A seed that never reaches the line (no greedy run is valid) ran to the frame cap: planned over
-    // that many frames, each count of the search takes tens of seconds. It is planned over as many
-    // frames as the baseline gives an invalid run, and the search grows the count from there if need be.
-    let n = match seed.crossing {
-        Some(c) => (c.frames as usize).saturating_sub(prefix_len),
-        None => {
-            let given_up = usize::try_from(given_up_frame(&bound)).unwrap_or(usize::MAX);
-            warm.len().min(given_up.saturating_sub(prefix_len))
-        }
-    };
-    // No plan crosses before the bound's frame.
-    let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
+    let (warm, n, lo) = planning_start(&planner, seed, &bound);
     // Stages 2 to 4, then 5 where the settings ask for it.
     let greedy_s = time_of(greedy);
     let mut found = plan_airborne(&mut planner, &base, warm, n, lo, greedy_s, progress);
@@ -612,8 +600,46 @@ fn solve_within(
             |planner| plan_polished_finely(planner, &mut found, fine, greedy_s, lo, progress),
         );
     }
-    // The verification ends where the outcome takes the solve's time: the stages add up to it.
-    let verification_from_s = seconds_since(started);
+    Ok(airborne_outcome(
+        &finisher, &planner, found, &budget, seconds,
+    ))
+}
+
+/// Where the relaxed stage starts from the seed run: the seed in planning controls, the frame count to
+/// plan over, and the count below which no plan can cross (the bound's).
+fn planning_start(
+    planner: &Planner,
+    seed: &Trace,
+    bound: &LowerBound,
+) -> (Vec<FrameControl>, usize, usize) {
+    let warm = planner.warm_start(seed);
+    let prefix_len = planner.prefix.len();
+    // A seed that never reaches the line (no greedy run is valid) ran to the frame cap: planned over
+    // that many frames, each count of the search takes tens of seconds. It is planned over as many
+    // frames as the baseline gives an invalid run, and the search grows the count from there if need be.
+    let n = match seed.crossing {
+        Some(c) => (c.frames as usize).saturating_sub(prefix_len),
+        None => {
+            let given_up = usize::try_from(given_up_frame(bound)).unwrap_or(usize::MAX);
+            warm.len().min(given_up.saturating_sub(prefix_len))
+        }
+    };
+    // No plan crosses before the bound's frame.
+    let lo = (bound.crossing.frames as usize).saturating_sub(1 + prefix_len);
+    (warm, n, lo)
+}
+
+/// The outcome of an airborne solve from what its stages `found` (the greedy run's where they found no
+/// plan faster), with its certificate, work and stage seconds (`seconds` holds the bound's and the
+/// baseline's); the verification's seconds end here, so the stages add up to the solve's time.
+fn airborne_outcome(
+    finisher: &Finisher,
+    planner: &Planner,
+    found: AirbornePlan,
+    budget: &Budget,
+    seconds: StageSeconds,
+) -> Outcome {
+    let verification_from_s = seconds_since(finisher.started);
     let relaxed = found
         .certifier
         .certificate_with_estimates(&planner.start, &planner.fl);
@@ -621,7 +647,7 @@ fn solve_within(
     let stopped = planner
         .cut_in
         .filter(|_| planner.timed_out)
-        .map(|stage| SearchStatus::stopped(&budget, stage));
+        .map(|stage| SearchStatus::stopped(budget, stage));
     let outcome = match found.best {
         Some((t, trace)) => {
             let status = stopped.unwrap_or(SearchStatus::Converged {
@@ -645,11 +671,11 @@ fn solve_within(
         verification: outcome.solve_seconds - verification_from_s,
         ..planner.seconds
     };
-    Ok(Outcome {
+    Outcome {
         relaxed,
         stage_seconds,
         ..outcome
-    })
+    }
 }
 
 /// Why no optimised plan was returned, from whether the relaxed stage found a line and the replays
