@@ -35,8 +35,50 @@ fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
         super::expect::validate(expect, ix)?;
     }
     let shape = shorthand(&file, ix)?;
+    let (vars, effects, max_frames) = engine_of(&file, ix)?;
+    let (walls, wall_keys) = walls_of(&file, shape.as_ref());
+    for (wall, key) in walls.iter().zip(&wall_keys) {
+        check_wall(wall, key, effects, ix)?;
+    }
+    let start = start_state(&file, shape.as_ref(), &vars, effects, ix)?;
+    let (finish, finish_key) = finish_line(&file, shape.as_ref(), ix)?;
+    let corridor = Corridor::new(&walls)?;
+    let start_key = if file.start.as_ref().and_then(|s| s.position).is_some() {
+        "start.position"
+    } else {
+        shape.as_ref().map_or("start.position", |s| s.name)
+    };
+    check_start_and_path(
+        &corridor,
+        &start,
+        start_key,
+        &wall_keys,
+        &finish,
+        &finish_key,
+        ix,
+    )?;
+    let name = file.name.clone().unwrap_or_else(|| {
+        Path::new(origin)
+            .file_stem()
+            .map_or_else(|| origin.to_string(), |s| s.to_string_lossy().into_owned())
+    });
+    Ok(Scene {
+        name,
+        description: file.description.clone().unwrap_or_default(),
+        origin: origin.to_string(),
+        preset: file.engine.preset,
+        vars,
+        effects,
+        start,
+        finish,
+        walls,
+        max_frames,
+    })
+}
 
-    // Engine: preset + overrides, then effects (docs/physics.md sections 2, 3).
+/// The engine of a scene file: its preset with the overrides, its effects (each with what it needs),
+/// and the most frames a run of it may take (docs/physics.md sections 2, 3).
+fn engine_of(file: &SceneFile, ix: &KeyIndex<'_>) -> Result<(MovementVars, Effects, u64)> {
     let engine = &file.engine;
     let fps = engine.overrides.fps.ok_or_else(|| {
         ix.error(
@@ -61,11 +103,15 @@ fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
         // Finite and positive: vars.validate() checked the frame time.
         None => (DEFAULT_MAX_TIME_S / vars.frame_time_s()).ceil() as u64,
     };
+    Ok((vars, effects, max_frames))
+}
 
-    // Walls: the shape's, then the file's; `wall_keys` names each in messages.
+/// The walls of a scene: the shorthand shape's, then the file's, each with the key that names it in
+/// messages.
+fn walls_of(file: &SceneFile, shape: Option<&Shape>) -> (Vec<Wall>, Vec<String>) {
     let mut walls = Vec::new();
     let mut wall_keys = Vec::new();
-    if let Some(s) = &shape {
+    if let Some(s) = shape {
         for w in &s.expanded.walls {
             walls.push(w.clone());
             wall_keys.push(s.name.to_string());
@@ -79,68 +125,75 @@ fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
         });
         wall_keys.push(format!("walls[{i}]"));
     }
-    for (wall, key) in walls.iter().zip(&wall_keys) {
-        let points_key = if key.starts_with("walls[") {
-            format!("{key}.points")
-        } else {
-            key.clone()
-        };
-        // The point `i` of this wall in messages: its own line for a file's wall, else the shape's.
-        let point_key = |i: usize| {
-            if key.starts_with("walls[") {
-                format!("{points_key}[{i}]")
-            } else {
-                points_key.clone()
-            }
-        };
-        let defect = wall.defect();
-        // Too few or non-finite points first; then the range, before any shape test measures lengths.
-        let out_of_range = wall.points.iter().position(|&p| !within_range(p));
-        if let (
-            None | Some(WallDefect::ZeroLength { .. } | WallDefect::SelfIntersection { .. }),
-            Some(i),
-        ) = (defect, out_of_range)
-        {
-            let q = wall.points[i];
-            let what = if key.starts_with("walls[") {
-                format!("point {i} is at")
-            } else {
-                format!("[{key}] reaches")
-            };
-            return Err(ix.error_at(
-                &points_key,
-                &point_key(i),
-                format!(
-                    "{what} ({}, {}); every coordinate must be between -{MAX_COORDINATE_UNITS} and \
-                     {MAX_COORDINATE_UNITS} units",
-                    short(q.x),
-                    short(q.y),
-                ),
-            ));
-        }
-        if let Some(defect) = defect {
-            let locate_at = defect.point().map_or(points_key.clone(), point_key);
-            return Err(ix.error_at(&points_key, &locate_at, defect.to_string()));
-        }
-        if wall.kind == BoundaryKind::Solid && !effects.has(Effect::Walls) {
-            return Err(ix.error(
-                &format!("{key}.kind"),
-                "solid walls need the \"walls\" effect; add \"walls\" to engine.effects, or use \
-                 kind = \"rule\"",
-            ));
-        }
-    }
+    (walls, wall_keys)
+}
 
-    let start = start_state(&file, shape.as_ref(), &vars, effects, ix)?;
-    let (finish, finish_key) = finish_line(&file, shape.as_ref(), ix)?;
-
-    // Geometry: the start hull must be clear of every wall, and the finish reachable from it.
-    let corridor = Corridor::new(&walls)?;
-    let start_key = if file.start.as_ref().and_then(|s| s.position).is_some() {
-        "start.position"
+/// A wall named `key` checked: enough finite points, every one in range, no zero-length segment nor
+/// self-intersection, and solid only with the walls effect.
+fn check_wall(wall: &Wall, key: &str, effects: Effects, ix: &KeyIndex<'_>) -> Result<()> {
+    let points_key = if key.starts_with("walls[") {
+        format!("{key}.points")
     } else {
-        shape.as_ref().map_or("start.position", |s| s.name)
+        key.to_string()
     };
+    // The point `i` of this wall in messages: its own line for a file's wall, else the shape's.
+    let point_key = |i: usize| {
+        if key.starts_with("walls[") {
+            format!("{points_key}[{i}]")
+        } else {
+            points_key.clone()
+        }
+    };
+    let defect = wall.defect();
+    // Too few or non-finite points first; then the range, before any shape test measures lengths.
+    let out_of_range = wall.points.iter().position(|&p| !within_range(p));
+    if let (
+        None | Some(WallDefect::ZeroLength { .. } | WallDefect::SelfIntersection { .. }),
+        Some(i),
+    ) = (defect, out_of_range)
+    {
+        let q = wall.points[i];
+        let what = if key.starts_with("walls[") {
+            format!("point {i} is at")
+        } else {
+            format!("[{key}] reaches")
+        };
+        return Err(ix.error_at(
+            &points_key,
+            &point_key(i),
+            format!(
+                "{what} ({}, {}); every coordinate must be between -{MAX_COORDINATE_UNITS} and \
+                 {MAX_COORDINATE_UNITS} units",
+                short(q.x),
+                short(q.y),
+            ),
+        ));
+    }
+    if let Some(defect) = defect {
+        let locate_at = defect.point().map_or(points_key.clone(), point_key);
+        return Err(ix.error_at(&points_key, &locate_at, defect.to_string()));
+    }
+    if wall.kind == BoundaryKind::Solid && !effects.has(Effect::Walls) {
+        return Err(ix.error(
+            &format!("{key}.kind"),
+            "solid walls need the \"walls\" effect; add \"walls\" to engine.effects, or use \
+             kind = \"rule\"",
+        ));
+    }
+    Ok(())
+}
+
+/// The geometry's checks: the start hull clear of every wall (`start_key` names the start, `wall_keys`
+/// the walls), and the finish line (`finish_key`) reachable from it.
+fn check_start_and_path(
+    corridor: &Corridor,
+    start: &PlayerState,
+    start_key: &str,
+    wall_keys: &[String],
+    finish: &FinishLine,
+    finish_key: &str,
+    ix: &KeyIndex<'_>,
+) -> Result<()> {
     if let Some(n) = corridor.nearest(start.pos, None) {
         if n.clearance_units < -CONTACT_TOL_UNITS {
             return Err(ix.error_at(
@@ -163,7 +216,7 @@ fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
         .is_none()
     {
         return Err(ix.error(
-            &finish_key,
+            finish_key,
             format!(
                 "no path for the hull from the start ({}, {}) to the finish line ({}, {})-({}, {}); the walls \
                  must leave the 32 x 32 hull a way through",
@@ -171,24 +224,7 @@ fn build(file: SceneFile, ix: &KeyIndex<'_>, origin: &str) -> Result<Scene> {
             ),
         ));
     }
-
-    let name = file.name.clone().unwrap_or_else(|| {
-        Path::new(origin)
-            .file_stem()
-            .map_or_else(|| origin.to_string(), |s| s.to_string_lossy().into_owned())
-    });
-    Ok(Scene {
-        name,
-        description: file.description.clone().unwrap_or_default(),
-        origin: origin.to_string(),
-        preset: engine.preset,
-        vars,
-        effects,
-        start,
-        finish,
-        walls,
-        max_frames,
-    })
+    Ok(())
 }
 
 /// The one shorthand shape given, expanded; an error when more than one is given or a parameter is out
