@@ -247,30 +247,42 @@ pub fn field(label: &str, value: impl std::fmt::Display) -> String {
 }
 
 fn summary_text(scene: &Scene, o: &Outcome) -> String {
-    let fmt_time = |c: Option<crate::sim::Crossing>| {
-        c.map_or("not reached".to_string(), |c| {
-            format!(
-                "{:>10.6} s (frame {}, {:.4} through it)",
-                c.time, c.frames, c.fraction
-            )
-        })
-    };
-    let lb = o.bound.crossing;
     let mut s = format!(
         "{} ({} at {} fps)\n",
         scene.name,
         scene.preset.name(),
         fps_text(scene.vars.fps)
     );
-    s.push_str(&field(
+    s.push_str(&runs_text(o));
+    s.push_str(&certificate_text(scene, o));
+    s.push_str(&gains_text(o));
+    s.push_str(&work_text(o));
+    s
+}
+
+/// A crossing's time, frame and how far through it, or that the line was not reached.
+fn crossing_text(c: Option<crate::sim::Crossing>) -> String {
+    c.map_or("not reached".to_string(), |c| {
+        format!(
+            "{:>10.6} s (frame {}, {:.4} through it)",
+            c.time, c.frames, c.fraction
+        )
+    })
+}
+
+/// The summary's runs: the plan, its engine-exact replay, the greedy run and its guide, and the lower
+/// bound.
+fn runs_text(o: &Outcome) -> String {
+    let lb = o.bound.crossing;
+    let mut s = field(
         "plan",
-        format!("{} ({})", fmt_time(o.trace.crossing), o.source),
-    ));
+        format!("{} ({})", crossing_text(o.trace.crossing), o.source),
+    );
     s.push_str(&field(
         "engine-exact",
         format!(
             "{}, {}",
-            fmt_time(o.engine_exact.crossing),
+            crossing_text(o.engine_exact.crossing),
             match (o.engine_exact.feasible(), o.engine_exact.interrupted) {
                 (true, _) => "valid",
                 (false, true) => "not checked (stopped)",
@@ -282,7 +294,7 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         "greedy",
         format!(
             "{}, {}",
-            fmt_time(o.greedy.crossing),
+            crossing_text(o.greedy.crossing),
             if o.greedy.feasible() {
                 "valid"
             } else {
@@ -295,6 +307,12 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         "lower bound",
         format!("{:>10.6} s (frame {})", lb.time, lb.frames),
     ));
+    s
+}
+
+/// The summary's certificate: the relaxed optimum with its starts and spread, and the rounding loss.
+fn certificate_text(scene: &Scene, o: &Outcome) -> String {
+    let mut s = String::new();
     if let Some(r) = o.relaxed {
         let spread = match r.short {
             0 => format!("spread {:.6} s", r.spread),
@@ -319,6 +337,14 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
         let text = rounding_loss_text(loss, o.trace.min_clearance(), zigzag, guard);
         s.push_str(&field("rounding loss", text));
     }
+    s
+}
+
+/// The summary's comparisons of a plan that crosses: its gap to the lower bound and its gain on a valid
+/// greedy run.
+fn gains_text(o: &Outcome) -> String {
+    let mut s = String::new();
+    let lb = o.bound.crossing;
     if let Some(c) = o.trace.crossing {
         s.push_str(&field(
             "gap to bound",
@@ -338,15 +364,20 @@ fn summary_text(scene: &Scene, o: &Outcome) -> String {
             ));
         }
     }
+    s
+}
+
+/// The summary's plan clearance, status and work: the solve's time, iterations and seconds by stage.
+fn work_text(o: &Outcome) -> String {
     let clearance = o.trace.min_clearance();
-    s.push_str(&field(
+    let mut s = field(
         "min clearance",
         if clearance.is_finite() {
             format!("{clearance:>10.6} units")
         } else {
             "no walls".to_string()
         },
-    ));
+    );
     s.push_str(&field("status", &o.status));
     s.push_str(&field(
         "solve time",
