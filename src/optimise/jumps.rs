@@ -381,6 +381,99 @@ impl Search<'_, '_, '_> {
             .as_ref()
             .map_or(JumpPolicy::default(), |b| b.policy)
     }
+
+    /// The start phase tried on a full grid from the best policy: the first jump's tick (from `first`,
+    /// the first tick on the ground) and kind, walking while standing up, ground strafing.
+    fn start_phase_swept(&mut self, first: u64) {
+        let base = self.best_policy();
+        for kind in [JumpKind::Standing, JumpKind::Ducked] {
+            for walk_while_unducking in [false, true] {
+                for ground_strafe in [false, true] {
+                    for tick in first..first + FIRST_JUMP_WINDOW_TICKS {
+                        self.try_policy(JumpPolicy {
+                            first_jump_tick: tick,
+                            first_jump: kind,
+                            walk_while_unducking,
+                            ground_strafe,
+                            ..base
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    /// The flight tried on `grid` from the best policy: air strafing, the strafe key on jump ticks, and
+    /// both steering horizons (the boost's return as shares of the jump's `airtime_s`).
+    fn flight_swept(&mut self, grid: &SweepGrid, airtime_s: f64) {
+        let base = self.best_policy();
+        let mut returns: Vec<Option<f64>> = vec![None];
+        returns.extend(grid.return_factors.iter().map(|f| Some(f * airtime_s)));
+        for air_strafe in [true, false] {
+            for jump_tick_strafe in [true, false] {
+                for &steer_time_s in grid.steer_times {
+                    for &boost_return_s in &returns {
+                        self.try_policy(JumpPolicy {
+                            air_strafe,
+                            jump_tick_strafe,
+                            steer_time_s,
+                            boost_return_s,
+                            ..base
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    /// The jump kinds and the wait on the ground tried one at a time, each from the best policy so far.
+    fn ground_swept(&mut self) {
+        for standing_jumps in 0..=MAX_STANDING_JUMPS {
+            self.try_policy(JumpPolicy {
+                standing_jumps,
+                ..self.best_policy()
+            });
+        }
+        for jump_delay_ticks in 0..=MAX_JUMP_DELAY_TICKS {
+            self.try_policy(JumpPolicy {
+                jump_delay_ticks,
+                ..self.best_policy()
+            });
+        }
+    }
+}
+
+/// The policy search's grid at a quality level: most coordinate-descent sweeps, the steering horizons
+/// (seconds) and the boost's return times (shares of the jump's airtime) tried.
+struct SweepGrid {
+    sweeps_max: u64,
+    steer_times: &'static [f64],
+    return_factors: &'static [f64],
+}
+
+impl SweepGrid {
+    fn of(quality: Quality) -> SweepGrid {
+        let (sweeps_max, steer_times, return_factors): (u64, &[f64], &[f64]) = match quality {
+            Quality::Fast => (2, &[0.1, 0.2, 0.4, 0.8], &[0.5, 1.0, 2.0]),
+            Quality::Balanced => (
+                4,
+                &[0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.6, 0.8, 1.2],
+                &[0.5, 0.75, 1.0, 1.5, 2.0, 3.0],
+            ),
+            Quality::Exact => (
+                8,
+                &[
+                    0.05, 0.075, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.8, 1.0, 1.2, 1.6,
+                ],
+                &[0.4, 0.5, 0.6, 0.75, 0.9, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0],
+            ),
+        };
+        SweepGrid {
+            sweeps_max,
+            steer_times,
+            return_factors,
+        }
+    }
 }
 
 /// The earliest tick on which the player can be on the ground, from the scene's start.
@@ -426,77 +519,16 @@ pub fn plan_jumps(sim: &Simulation, settings: &SearchSettings, budget: Budget) -
 
     let first = first_ground_tick(sim);
     let airtime = jump_airtime_s(&sim.scene().vars).unwrap_or(0.5);
-    let (sweeps_max, steer_times, return_factors): (u64, &[f64], &[f64]) = match settings.quality {
-        Quality::Fast => (2, &[0.1, 0.2, 0.4, 0.8], &[0.5, 1.0, 2.0]),
-        Quality::Balanced => (
-            4,
-            &[0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.6, 0.8, 1.2],
-            &[0.5, 0.75, 1.0, 1.5, 2.0, 3.0],
-        ),
-        Quality::Exact => (
-            8,
-            &[
-                0.05, 0.075, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.8, 1.0, 1.2, 1.6,
-            ],
-            &[0.4, 0.5, 0.6, 0.75, 0.9, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0],
-        ),
-    };
+    let grid = SweepGrid::of(settings.quality);
     let mut sweeps = 0;
     loop {
         sweeps += 1;
         let before = search.best.as_ref().map_or(f64::INFINITY, |b| b.time());
-        // The start phase on a full grid: first jump tick, its kind, walking while standing up, ground
-        // strafing.
-        let base = search.best_policy();
-        for kind in [JumpKind::Standing, JumpKind::Ducked] {
-            for walk_while_unducking in [false, true] {
-                for ground_strafe in [false, true] {
-                    for tick in first..first + FIRST_JUMP_WINDOW_TICKS {
-                        search.try_policy(JumpPolicy {
-                            first_jump_tick: tick,
-                            first_jump: kind,
-                            walk_while_unducking,
-                            ground_strafe,
-                            ..base
-                        });
-                    }
-                }
-            }
-        }
-        // The flight on a full grid: air strafing, the strafe key on jump ticks, both steering horizons.
-        let base = search.best_policy();
-        let mut returns: Vec<Option<f64>> = vec![None];
-        returns.extend(return_factors.iter().map(|f| Some(f * airtime)));
-        for air_strafe in [true, false] {
-            for jump_tick_strafe in [true, false] {
-                for &steer_time_s in steer_times {
-                    for &boost_return_s in &returns {
-                        search.try_policy(JumpPolicy {
-                            air_strafe,
-                            jump_tick_strafe,
-                            steer_time_s,
-                            boost_return_s,
-                            ..base
-                        });
-                    }
-                }
-            }
-        }
-        // The jump kinds and the wait on the ground, one at a time.
-        for standing_jumps in 0..=MAX_STANDING_JUMPS {
-            search.try_policy(JumpPolicy {
-                standing_jumps,
-                ..search.best_policy()
-            });
-        }
-        for jump_delay_ticks in 0..=MAX_JUMP_DELAY_TICKS {
-            search.try_policy(JumpPolicy {
-                jump_delay_ticks,
-                ..search.best_policy()
-            });
-        }
+        search.start_phase_swept(first);
+        search.flight_swept(&grid, airtime);
+        search.ground_swept();
         let after = search.best.as_ref().map_or(f64::INFINITY, |b| b.time());
-        if after >= before || sweeps >= sweeps_max || search.timed_out {
+        if after >= before || sweeps >= grid.sweeps_max || search.timed_out {
             break;
         }
     }
