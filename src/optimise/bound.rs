@@ -282,71 +282,11 @@ fn schedule_search(
     }
     let tau = vars.frame_time_s();
     let stepper: Stepper<f64> = Stepper::new(vars, fx);
-    let idle = Wish {
-        forward: Vec2::new(1.0, 0.0),
-        ..Wish::default()
-    };
     let probe_frames = scene.max_frames.min(MAX_SCHEDULE_PROBE_FRAMES);
-    // The first frame that starts on the ground, and the first frame that can be standing (duck released
-    // from the start).
-    let mut s = scene.start;
-    let mut first_ground = None;
-    let mut standing_from = if s.ducked { None } else { Some(1) };
-    for frame in 1..=probe_frames {
-        if s.on_ground && first_ground.is_none() {
-            first_ground = Some(frame);
-        }
-        stepper.step(&mut s, &idle);
-        if !s.ducked && standing_from.is_none() {
-            standing_from = Some(frame);
-        }
-        if first_ground.is_some() && standing_from.is_some() {
-            break;
-        }
-    }
-    let first_ground = first_ground?;
-    let standing_from = standing_from.unwrap_or(u64::MAX);
-    // The airtimes: frames from a jump frame to the next frame that starts on the ground, standing and
-    // (with the duck effect) ducked.
-    let airtime_of = |ducked: bool| -> Option<u64> {
-        let mut s = PlayerState::on_ground(Vec2::ZERO, Vec2::ZERO);
-        s.ducked = ducked;
-        let jump = Wish {
-            jump: true,
-            duck: ducked,
-            ..idle
-        };
-        let hold = Wish {
-            duck: ducked,
-            ..idle
-        };
-        stepper.step(&mut s, &jump);
-        let mut airtime = 1u64;
-        while !s.on_ground {
-            if airtime >= probe_frames {
-                return None;
-            }
-            stepper.step(&mut s, &hold);
-            airtime += 1;
-        }
-        Some(airtime)
-    };
-    let standing_airtime = airtime_of(false)?;
-    let ducked_airtime = if fx.has(Effect::Duck) {
-        airtime_of(true)?
-    } else {
-        standing_airtime
-    };
-    let m = vars
-        .maxspeed
-        .min(vars.forward_key_speed.hypot(vars.side_key_speed));
+    let (first_ground, standing_from) = first_ground_and_standing(scene, &stepper, probe_frames)?;
+    let (standing_airtime, ducked_airtime) = airtimes(&stepper, fx, probe_frames)?;
+    let (m, m_ducked) = wish_speeds_ups(vars);
     let crop = vars.duck_multiplier;
-    let m_ducked = match vars.game {
-        Game::Source => crop * m,
-        Game::GoldSrc => vars
-            .maxspeed
-            .min(crop * vars.forward_key_speed.hypot(vars.side_key_speed)),
-    };
     let law = |wish: f64| {
         fx.has(Effect::GroundAccel)
             .then(|| AccelLaw::ground(vars, wish))
@@ -375,6 +315,92 @@ fn schedule_search(
         along_cap,
     };
     Some((search, first_ground))
+}
+
+/// The first frame that starts on the ground and the first that can be standing (duck released from
+/// the start; `u64::MAX` if none within `probe_frames`), the start played idle; `None` when it never lands
+/// within `probe_frames`.
+fn first_ground_and_standing(
+    scene: &Scene,
+    stepper: &Stepper<f64>,
+    probe_frames: u64,
+) -> Option<(u64, u64)> {
+    let mut s = scene.start;
+    let mut first_ground = None;
+    let mut standing_from = if s.ducked { None } else { Some(1) };
+    for frame in 1..=probe_frames {
+        if s.on_ground && first_ground.is_none() {
+            first_ground = Some(frame);
+        }
+        stepper.step(&mut s, &idle_forward());
+        if !s.ducked && standing_from.is_none() {
+            standing_from = Some(frame);
+        }
+        if first_ground.is_some() && standing_from.is_some() {
+            break;
+        }
+    }
+    Some((first_ground?, standing_from.unwrap_or(u64::MAX)))
+}
+
+/// No keys, facing along x.
+fn idle_forward() -> Wish {
+    Wish {
+        forward: Vec2::new(1.0, 0.0),
+        ..Wish::default()
+    }
+}
+
+/// The airtimes, standing and (with the duck effect, else the standing one again) ducked: frames from a
+/// jump frame to the next frame that starts on the ground; `None` when a jump does not land within
+/// `probe_frames`.
+fn airtimes(stepper: &Stepper<f64>, fx: Effects, probe_frames: u64) -> Option<(u64, u64)> {
+    let airtime_of = |ducked: bool| -> Option<u64> {
+        let mut s = PlayerState::on_ground(Vec2::ZERO, Vec2::ZERO);
+        s.ducked = ducked;
+        let jump = Wish {
+            jump: true,
+            duck: ducked,
+            ..idle_forward()
+        };
+        let hold = Wish {
+            duck: ducked,
+            ..idle_forward()
+        };
+        stepper.step(&mut s, &jump);
+        let mut airtime = 1u64;
+        while !s.on_ground {
+            if airtime >= probe_frames {
+                return None;
+            }
+            stepper.step(&mut s, &hold);
+            airtime += 1;
+        }
+        Some(airtime)
+    };
+    let standing_airtime = airtime_of(false)?;
+    let ducked_airtime = if fx.has(Effect::Duck) {
+        airtime_of(true)?
+    } else {
+        standing_airtime
+    };
+    Some((standing_airtime, ducked_airtime))
+}
+
+/// The wish speed of a ground frame with the movement keys, standing and ducked, ups (each game crops a
+/// ducked wish its own way).
+fn wish_speeds_ups(vars: &MovementVars) -> (f64, f64) {
+    let m = vars
+        .maxspeed
+        .min(vars.forward_key_speed.hypot(vars.side_key_speed));
+    let crop = vars.duck_multiplier;
+    let m_ducked = match vars.game {
+        Game::Source => crop * m,
+        Game::GoldSrc => vars
+            .maxspeed
+            .min(crop * vars.forward_key_speed.hypot(vars.side_key_speed)),
+    };
+    (m, m_ducked)
 }
 
 /// Frames [`jump_schedule_time_to_cover`] steps to find the first landing, the unduck frame and the
