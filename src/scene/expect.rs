@@ -209,35 +209,61 @@ pub fn expectation_from_str(text: &str, origin: &str) -> Result<Option<Expectati
 /// Checks the values of an `[expect]` table and the keys that go together.
 pub(crate) fn validate(file: &ExpectFile, ix: &KeyIndex<'_>) -> Result<Expectation> {
     if let Some(message) = &file.error {
-        let others = [
-            ("command", file.command.is_some()),
-            ("quality", file.quality.is_some()),
-            ("controller", file.controller.is_some()),
-            ("frames", file.frames.is_some()),
-            ("time", file.time.is_some()),
-            ("time-tolerance", file.time_tolerance.is_some()),
-            ("gap-percent", file.gap_percent.is_some()),
-            ("valid", file.valid.is_some()),
-            ("engine-exact-valid", file.engine_exact_valid.is_some()),
-            ("status", file.status.is_some()),
-        ];
-        if let Some((key, _)) = others.iter().find(|(_, given)| *given) {
-            return Err(ix.error(
-                &format!("expect.{key}"),
-                "an expected refusal (expect.error) takes no other key: a refused scene runs nothing",
-            ));
-        }
-        if message.trim().is_empty() {
-            return Err(ix.error(
-                "expect.error",
-                "empty; give a part of the message the scene must be refused with",
-            ));
-        }
-        return Ok(Expectation::Refused {
-            message_contains: message.clone(),
-        });
+        return refusal(file, message, ix);
     }
+    let run = expected_run(file, ix)?;
+    let time_tolerance_s = checked_limits(file, ix)?;
+    if let Some(StatusList(names)) = &file.status {
+        check_statuses(names, ix)?;
+    }
+    Ok(Expectation::Runs {
+        run,
+        limits: Limits {
+            frames: file.frames,
+            time_s: file.time,
+            time_tolerance_s,
+            gap_percent: file.gap_percent,
+            valid: file.valid,
+            engine_exact_valid: file.engine_exact_valid,
+            status: file.status.as_ref().map(|s| s.0.clone()),
+        },
+    })
+}
 
+/// An expected refusal: `expect.error` alone, a part of the message the scene must be refused with.
+fn refusal(file: &ExpectFile, message: &str, ix: &KeyIndex<'_>) -> Result<Expectation> {
+    let others = [
+        ("command", file.command.is_some()),
+        ("quality", file.quality.is_some()),
+        ("controller", file.controller.is_some()),
+        ("frames", file.frames.is_some()),
+        ("time", file.time.is_some()),
+        ("time-tolerance", file.time_tolerance.is_some()),
+        ("gap-percent", file.gap_percent.is_some()),
+        ("valid", file.valid.is_some()),
+        ("engine-exact-valid", file.engine_exact_valid.is_some()),
+        ("status", file.status.is_some()),
+    ];
+    if let Some((key, _)) = others.iter().find(|(_, given)| *given) {
+        return Err(ix.error(
+            &format!("expect.{key}"),
+            "an expected refusal (expect.error) takes no other key: a refused scene runs nothing",
+        ));
+    }
+    if message.trim().is_empty() {
+        return Err(ix.error(
+            "expect.error",
+            "empty; give a part of the message the scene must be refused with",
+        ));
+    }
+    Ok(Expectation::Refused {
+        message_contains: message.to_string(),
+    })
+}
+
+/// The run an expectation is about: `solve` at its quality or `simulate` with its controller, each
+/// refusing the other's keys.
+fn expected_run(file: &ExpectFile, ix: &KeyIndex<'_>) -> Result<ExpectedRun> {
     let command = file.command.unwrap_or(ExpectCommand::Solve);
     let solve_only = [
         ("quality", file.quality.is_some()),
@@ -255,13 +281,16 @@ pub(crate) fn validate(file: &ExpectFile, ix: &KeyIndex<'_>) -> Result<Expectati
             format!("only with command = \"{other}\""),
         ));
     }
-    let run = match command {
+    Ok(match command {
         ExpectCommand::Solve => ExpectedRun::Solve(file.quality.unwrap_or(ExpectQuality::Balanced)),
         ExpectCommand::Simulate => {
             ExpectedRun::Simulate(file.controller.unwrap_or(ExpectController::Greedy))
         }
-    };
+    })
+}
 
+/// The frames, time and gap limits checked in range; the time's tolerance, seconds (0 when not given).
+fn checked_limits(file: &ExpectFile, ix: &KeyIndex<'_>) -> Result<f64> {
     if file.frames == Some(0) {
         return Err(ix.error(
             "expect.frames",
@@ -295,37 +324,29 @@ pub(crate) fn validate(file: &ExpectFile, ix: &KeyIndex<'_>) -> Result<Expectati
             ));
         }
     }
-    if let Some(StatusList(names)) = &file.status {
-        if names.is_empty() {
-            return Err(ix.error(
-                "expect.status",
-                format!(
-                    "an empty list; give one or more of {}",
-                    SOLVE_STATUSES.join(", ")
-                ),
-            ));
-        }
-        if let Some(bad) = names.iter().find(|n| !SOLVE_STATUSES.contains(&n.as_str())) {
-            return Err(ix.error(
-                "expect.status",
-                format!(
-                    "unknown status \"{}\"; must be one of {}",
-                    super::locate::one_line(bad),
-                    SOLVE_STATUSES.join(", ")
-                ),
-            ));
-        }
+    Ok(time_tolerance_s)
+}
+
+/// The statuses a solve may end with: one or more, each a known one.
+fn check_statuses(names: &[String], ix: &KeyIndex<'_>) -> Result<()> {
+    if names.is_empty() {
+        return Err(ix.error(
+            "expect.status",
+            format!(
+                "an empty list; give one or more of {}",
+                SOLVE_STATUSES.join(", ")
+            ),
+        ));
     }
-    Ok(Expectation::Runs {
-        run,
-        limits: Limits {
-            frames: file.frames,
-            time_s: file.time,
-            time_tolerance_s,
-            gap_percent: file.gap_percent,
-            valid: file.valid,
-            engine_exact_valid: file.engine_exact_valid,
-            status: file.status.as_ref().map(|s| s.0.clone()),
-        },
-    })
+    if let Some(bad) = names.iter().find(|n| !SOLVE_STATUSES.contains(&n.as_str())) {
+        return Err(ix.error(
+            "expect.status",
+            format!(
+                "unknown status \"{}\"; must be one of {}",
+                super::locate::one_line(bad),
+                SOLVE_STATUSES.join(", ")
+            ),
+        ));
+    }
+    Ok(())
 }
