@@ -13,9 +13,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{Corridor, FinishPoint, HULL_HALF_WIDTH_UNITS};
 use crate::physics::strafe::max_accel;
 use crate::physics::vars::BHOP_CAP_FACTOR;
-use crate::physics::{
-    AccelLaw, Effect, Effects, Game, MovementVars, PlayerState, Stepper, Vec2, Wish,
-};
+use crate::physics::{AccelLaw, Effect, Effects, MovementVars, PlayerState, Stepper, Vec2, Wish};
 use crate::scene::Scene;
 pub use crate::sim::Crossing;
 use serde::Serialize;
@@ -285,7 +283,7 @@ fn schedule_search(
     let probe_frames = scene.max_frames.min(MAX_SCHEDULE_PROBE_FRAMES);
     let (first_ground, standing_from) = first_ground_and_standing(scene, &stepper, probe_frames)?;
     let (standing_airtime, ducked_airtime) = airtimes(&stepper, fx, probe_frames)?;
-    let (m, m_ducked) = wish_speeds_ups(vars);
+    let (m, m_ducked) = wish_speeds_ups(vars, &stepper);
     let crop = vars.duck_multiplier;
     let law = |wish: f64| {
         fx.has(Effect::GroundAccel)
@@ -387,19 +385,18 @@ fn airtimes(stepper: &Stepper<f64>, fx: Effects, probe_frames: u64) -> Option<(u
     Some((standing_airtime, ducked_airtime))
 }
 
-/// The wish speed of a ground frame with the movement keys, standing and ducked, ups (each game crops a
-/// ducked wish its own way).
-fn wish_speeds_ups(vars: &MovementVars) -> (f64, f64) {
-    let m = vars
-        .maxspeed
-        .min(vars.forward_key_speed.hypot(vars.side_key_speed));
-    let crop = vars.duck_multiplier;
-    let m_ducked = match vars.game {
-        Game::Source => crop * m,
-        Game::GoldSrc => vars
-            .maxspeed
-            .min(crop * vars.forward_key_speed.hypot(vars.side_key_speed)),
+/// The wish speed of a ground frame with the movement keys, standing and ducked, ups: the frame step's
+/// own [`Stepper::wish_direction`], so each game's duck crop comes in its own order.
+fn wish_speeds_ups(vars: &MovementVars, stepper: &Stepper<f64>) -> (f64, f64) {
+    let keys = Wish {
+        forward: Vec2::new(1.0, 0.0),
+        forwardmove: vars.forward_key_speed,
+        sidemove: vars.side_key_speed,
+        ..Wish::default()
     };
+    let on_ground = true;
+    let (_, m) = stepper.wish_direction(&keys, false, on_ground);
+    let (_, m_ducked) = stepper.wish_direction(&keys, true, on_ground);
     (m, m_ducked)
 }
 
