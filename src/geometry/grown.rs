@@ -47,6 +47,9 @@ pub(crate) struct GrownSegment {
     pub planes: [Plane; PLANE_COUNT],
     segment: Segment,
     hull: Cuboid,
+    /// The corners, anticlockwise ([`GrownSegment::vertices`]): found once, as the wall rows of every
+    /// sub-problem read them.
+    corners: Vec<Vec2>,
 }
 
 /// The open interval of times `t` (over all reals) during which a moving point is strictly inside a grown
@@ -110,6 +113,7 @@ impl GrownSegment {
             planes,
             segment: Segment::new(to_parry(a), to_parry(b)),
             hull: Cuboid::new(Vector::new(h, h)),
+            corners: box_swept_corners(a, b, h),
         }
     }
 
@@ -211,16 +215,21 @@ impl GrownSegment {
     }
 
     /// The grown segment's corners, anticlockwise (4 for an axis-aligned segment, else 6).
-    pub fn vertices(&self) -> Vec<Vec2> {
-        let h = self.hull.half_extents.x;
-        let mut pts = Vec::with_capacity(8);
-        for e in [self.a, self.b] {
-            for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
-                pts.push(e + Vec2::new(sx * h, sy * h));
-            }
-        }
-        convex_hull(pts)
+    pub fn vertices(&self) -> &[Vec2] {
+        &self.corners
     }
+}
+
+/// The corners of the box of half-width `h` swept from `a` to `b`: the convex hull of the box's corners
+/// at both ends.
+fn box_swept_corners(a: Vec2, b: Vec2, h: f64) -> Vec<Vec2> {
+    let mut pts = Vec::with_capacity(8);
+    for e in [a, b] {
+        for (sx, sy) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            pts.push(e + Vec2::new(sx * h, sy * h));
+        }
+    }
+    convex_hull(pts)
 }
 
 /// Convex hull of a few points (Andrew's monotone chain), anticlockwise, collinear points dropped.

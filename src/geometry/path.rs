@@ -43,7 +43,7 @@ impl Corridor {
         // Nodes: the start, the grown vertices outside every grown wall, the ends of the target stretches.
         let mut nodes = vec![from];
         for g in &obstacles {
-            nodes.extend(g.vertices().into_iter().filter(|&v| !inside_any(v)));
+            nodes.extend(g.vertices().iter().copied().filter(|&v| !inside_any(v)));
         }
         let (ta, te) = (to_segment.0, to_segment.1 - to_segment.0);
         for &(s0, s1) in &targets {

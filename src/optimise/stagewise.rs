@@ -826,10 +826,18 @@ fn factorised_capped(
                 h[4 + at][4 + at] += w;
                 continue;
             }
-            // Over every entry, not the frame's `n` alone: fixed bounds let the loop unroll, and the
-            // entries past `n` (where `z` is zero) are not read.
+            // Over every entry the passes below read, not the frame's `n` alone: fixed bounds let the
+            // loops unroll, and the entries past `n` (where `z` is zero) are not read. The state rows'
+            // control columns are not read either (`Q_vx` takes the control rows' state columns).
             let z = joined(&row.c, &row.d);
-            for (hi, zi) in h.iter_mut().zip(z) {
+            let (state_rows, control_rows) = h.split_at_mut(4);
+            for (hi, zi) in state_rows.iter_mut().zip(z) {
+                let wz = w * zi;
+                for (hij, zj) in hi[..4].iter_mut().zip(z) {
+                    *hij += wz * zj;
+                }
+            }
+            for (hi, zi) in control_rows.iter_mut().zip(&z[4..]) {
                 let wz = w * zi;
                 for (hij, zj) in hi.iter_mut().zip(z) {
                     *hij += wz * zj;
@@ -936,17 +944,28 @@ fn direction(
 
 /// The longest step up to `share` of the way to the boundary of `t, lambda >= 0`, at most 1.
 fn step_to_boundary(it: &Iterate, dir: &Direction, share: f64) -> f64 {
-    let mut alpha = 1.0_f64;
-    for (x, d) in
-        it.t.iter()
-            .zip(&dir.dt)
-            .chain(it.lambda.iter().zip(&dir.dlambda))
-    {
-        if *d < 0.0 {
-            alpha = alpha.min(share * (-x / d));
+    // `share` is positive and rounding is monotonic, so scaling the least ratio is scaling each.
+    let nearest = nearest_boundary(&it.t, &dir.dt).min(nearest_boundary(&it.lambda, &dir.dlambda));
+    (share * nearest).min(1.0)
+}
+
+/// The least `-x_i / d_i` over the entries with `d_i < 0` (infinite where none falls): how far along
+/// `d` the first entry of `x` reaches zero. Kept in four running minima, so that the divisions, each
+/// independent of the others, overlap instead of waiting on one chain of minima.
+fn nearest_boundary(x: &[f64], d: &[f64]) -> f64 {
+    let ratio = |x: f64, d: f64| if d < 0.0 { -x / d } else { f64::INFINITY };
+    let mut least = [f64::INFINITY; 4];
+    let (xs, ds) = (x.chunks_exact(4), d.chunks_exact(4));
+    let (x_rest, d_rest) = (xs.remainder(), ds.remainder());
+    for (xc, dc) in xs.zip(ds) {
+        for l in 0..4 {
+            least[l] = least[l].min(ratio(xc[l], dc[l]));
         }
     }
-    alpha
+    for (&xi, &di) in x_rest.iter().zip(d_rest) {
+        least[0] = least[0].min(ratio(xi, di));
+    }
+    least.into_iter().fold(f64::INFINITY, f64::min)
 }
 
 /// The iterate moved by `alpha` along `dir`, its states played again through the dynamics.
