@@ -14,11 +14,12 @@
 use crate::error::{Error, Result};
 use crate::geometry::HULL_HALF_WIDTH_UNITS;
 use crate::optimise::hillclimb::{hill_climb, HillClimbSettings};
-use crate::optimise::{lower_bound, solve, Quality, SearchSettings};
+use crate::optimise::{lower_bound, solve, LowerBound, Outcome, Quality, SearchSettings};
 use crate::physics::curvature::{bend_arc_radius, speed_for_radius};
+use crate::physics::Control;
 use crate::scene::Scene;
 use crate::sim::controllers::{best_capped_greedy, best_greedy, GREEDY_LOOKAHEADS_UNITS};
-use crate::sim::{Crossing, Simulation};
+use crate::sim::{Crossing, Simulation, Trace};
 use serde::Serialize;
 use std::time::{Duration, Instant};
 
@@ -205,106 +206,169 @@ pub fn measure_scene(
     bend_width_units: Option<f64>,
     settings: &BenchSettings,
 ) -> Result<Vec<BenchRow>> {
-    let mut rows = Vec::new();
     let t = Instant::now();
     let bound = lower_bound(scene, &scene.corridor()?)?;
     let scene = &crate::optimise::bound::frame_limited_scene(scene, &bound, settings.max_frames)?;
     let sim = Simulation::new(scene)?;
-    let corner = bend_width_units.and_then(|w| corner_speed_ups(scene, w));
+    let mut rows = vec![lower_bound_row(scene, &bound, bend_width_units, t)];
     let bt = bound.crossing.time;
-    let mut row = BenchRow::new(Section::Accuracy, scene, Method::LowerBound, 0, bt)
-        .crossing(Some(bound.crossing));
-    row.wall_seconds = t.elapsed().as_secs_f64();
-    row.corner_speed_ups = corner;
-    row.status = Some(format!("shortest path {:.1} units", bound.path_length));
-    rows.push(row);
+    let (greedy, greedy_row) = greedy_row(scene, &sim, &bound, bt);
+    rows.push(greedy_row);
+    let (start, start_seconds) = hill_climb_start(scene, &sim, &bound, greedy);
+    let mut last_plan = None;
+    for &q in &settings.levels {
+        let (row, out) = solve_row(scene, settings, q, bt)?;
+        let wall = row.wall_seconds;
+        rows.push(row);
+        if settings.hill_climb {
+            // The same wall time in total: the start's cost plus the climb.
+            let budget = Duration::from_secs_f64((wall - start_seconds).max(0.0));
+            let climb = (&start, start_seconds, budget);
+            rows.push(hill_climb_row(scene, &sim, settings, q, bt, climb));
+        }
+        last_plan = Some((q, out.controls));
+    }
+    if let Some((q, controls)) = last_plan {
+        rows.push(engine_exact_row(scene, &sim, q, &controls, bt));
+    }
+    Ok(rows)
+}
 
+/// The lower bound's row, timed from `t`, with the corner speed of a bend `bend_width_units` wide.
+fn lower_bound_row(
+    scene: &Scene,
+    bound: &LowerBound,
+    bend_width_units: Option<f64>,
+    t: Instant,
+) -> BenchRow {
+    let mut row = BenchRow::new(
+        Section::Accuracy,
+        scene,
+        Method::LowerBound,
+        0,
+        bound.crossing.time,
+    )
+    .crossing(Some(bound.crossing));
+    row.wall_seconds = t.elapsed().as_secs_f64();
+    row.corner_speed_ups = bend_width_units.and_then(|w| corner_speed_ups(scene, w));
+    row.status = Some(format!("shortest path {:.1} units", bound.path_length));
+    row
+}
+
+/// The best greedy run along the shortest path over the look-aheads, and its row (`bt`: the bound's
+/// crossing time, seconds).
+fn greedy_row(scene: &Scene, sim: &Simulation, bound: &LowerBound, bt: f64) -> (Trace, BenchRow) {
     let t = Instant::now();
-    let (greedy, lookahead) = best_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS);
+    let (greedy, lookahead) = best_greedy(sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS);
     let mut row =
         BenchRow::new(Section::Accuracy, scene, Method::Greedy, 1, bt).crossing(greedy.crossing);
     row.wall_seconds = t.elapsed().as_secs_f64();
     row.feasible = Some(greedy.feasible());
     row.evaluations = Some(GREEDY_LOOKAHEADS_UNITS.len() as u64);
     row.status = Some(format!("look-ahead {lookahead:.0} units"));
-    rows.push(row);
+    (greedy, row)
+}
 
-    // The hill climber's start: the same greedy run (capped where a corner needs it) `solve` starts from.
+/// The hill climber's start, and the seconds it took: the same greedy run (capped where a corner needs
+/// it) `solve` starts from; on the ground the greedy run itself.
+fn hill_climb_start(
+    scene: &Scene,
+    sim: &Simulation,
+    bound: &LowerBound,
+    greedy: Trace,
+) -> (Trace, f64) {
     let t = Instant::now();
     let start = if scene.effects.is_air_only() {
         let caps: Vec<f64> = CAP_BEND_WIDTHS_UNITS
             .iter()
             .filter_map(|&w| speed_for_radius(&scene.vars, bend_arc_radius(w)).ok())
             .collect();
-        best_capped_greedy(&sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS, &caps).0
+        best_capped_greedy(sim, &bound.path, &GREEDY_LOOKAHEADS_UNITS, &caps).0
     } else {
-        greedy.clone()
+        greedy
     };
-    let start_seconds = t.elapsed().as_secs_f64();
+    (start, t.elapsed().as_secs_f64())
+}
 
-    let mut last_plan = None;
-    for &q in &settings.levels {
-        let mut ss = SearchSettings::for_quality(q);
-        ss.time_limit = settings.time_limit;
-        ss.max_frames = settings.max_frames;
-        let t = Instant::now();
-        let out = solve(scene, &ss)?;
-        let wall = t.elapsed().as_secs_f64();
-        let mut row = BenchRow::new(Section::Accuracy, scene, Method::Solve, quality_rank(q), bt)
-            .crossing(out.trace.crossing);
-        row.quality = Some(q);
-        row.wall_seconds = wall;
-        row.feasible = Some(out.trace.feasible());
-        row.iterations = Some(out.stats.iterations);
-        row.evaluations = Some(out.stats.subproblems);
-        row.status = Some(format!("{} ({})", out.status, out.source));
-        rows.push(row);
-        if settings.hill_climb {
-            // The same wall time in total: the start's cost plus the climb.
-            let budget = Duration::from_secs_f64((wall - start_seconds).max(0.0));
-            let hc = HillClimbSettings::default()
-                .with_seed(settings.seed)
-                .with_time_budget(budget);
-            let h = hill_climb(&sim, &start, &hc);
-            let mut row = BenchRow::new(
-                Section::Accuracy,
-                scene,
-                Method::HillClimb,
-                quality_rank(q),
-                bt,
-            )
-            .crossing(h.trace.crossing);
-            row.quality = Some(q);
-            row.wall_seconds = start_seconds + h.seconds;
-            row.feasible = Some(h.trace.feasible());
-            row.iterations = Some(h.iterations);
-            row.evaluations = Some(h.evaluations);
-            row.status = Some(format!(
-                "{} accepted; engine-exact {}",
-                h.accepted,
-                if h.engine_exact.feasible() {
-                    "valid"
-                } else {
-                    "INVALID"
-                }
-            ));
-            rows.push(row);
-        }
-        last_plan = Some((q, out.controls));
-    }
+/// `solve` at level `q` and its row.
+fn solve_row(
+    scene: &Scene,
+    settings: &BenchSettings,
+    q: Quality,
+    bt: f64,
+) -> Result<(BenchRow, Outcome)> {
+    let mut ss = SearchSettings::for_quality(q);
+    ss.time_limit = settings.time_limit;
+    ss.max_frames = settings.max_frames;
+    let t = Instant::now();
+    let out = solve(scene, &ss)?;
+    let mut row = BenchRow::new(Section::Accuracy, scene, Method::Solve, quality_rank(q), bt)
+        .crossing(out.trace.crossing);
+    row.quality = Some(q);
+    row.wall_seconds = t.elapsed().as_secs_f64();
+    row.feasible = Some(out.trace.feasible());
+    row.iterations = Some(out.stats.iterations);
+    row.evaluations = Some(out.stats.subproblems);
+    row.status = Some(format!("{} ({})", out.status, out.source));
+    Ok((row, out))
+}
 
-    if let Some((q, controls)) = last_plan {
-        let t = Instant::now();
-        let run = sim.run_engine_exact(&controls);
-        let mut row = BenchRow::new(Section::Accuracy, scene, Method::EngineExact, 5, bt)
-            .crossing(run.crossing);
-        row.wall_seconds = t.elapsed().as_secs_f64();
-        row.quality = Some(q);
-        row.feasible = Some(run.feasible());
-        row.status = Some(format!("replay of the {} plan", quality_name(q)));
-        rows.push(row);
-    }
-    Ok(rows)
+/// The hill climber's row beside level `q`: from `climb`'s start (found in its seconds) for its budget.
+fn hill_climb_row(
+    scene: &Scene,
+    sim: &Simulation,
+    settings: &BenchSettings,
+    q: Quality,
+    bt: f64,
+    climb: (&Trace, f64, Duration),
+) -> BenchRow {
+    let (start, start_seconds, budget) = climb;
+    let hc = HillClimbSettings::default()
+        .with_seed(settings.seed)
+        .with_time_budget(budget);
+    let h = hill_climb(sim, start, &hc);
+    let mut row = BenchRow::new(
+        Section::Accuracy,
+        scene,
+        Method::HillClimb,
+        quality_rank(q),
+        bt,
+    )
+    .crossing(h.trace.crossing);
+    row.quality = Some(q);
+    row.wall_seconds = start_seconds + h.seconds;
+    row.feasible = Some(h.trace.feasible());
+    row.iterations = Some(h.iterations);
+    row.evaluations = Some(h.evaluations);
+    let engine_exact = if h.engine_exact.feasible() {
+        "valid"
+    } else {
+        "INVALID"
+    };
+    row.status = Some(format!(
+        "{} accepted; engine-exact {engine_exact}",
+        h.accepted
+    ));
+    row
+}
+
+/// The engine-exact replay of level `q`'s plan `controls`, and its row.
+fn engine_exact_row(
+    scene: &Scene,
+    sim: &Simulation,
+    q: Quality,
+    controls: &[Control],
+    bt: f64,
+) -> BenchRow {
+    let t = Instant::now();
+    let run = sim.run_engine_exact(controls);
+    let mut row =
+        BenchRow::new(Section::Accuracy, scene, Method::EngineExact, 5, bt).crossing(run.crossing);
+    row.wall_seconds = t.elapsed().as_secs_f64();
+    row.quality = Some(q);
+    row.feasible = Some(run.feasible());
+    row.status = Some(format!("replay of the {} plan", quality_name(q)));
+    row
 }
 
 /// `scene` at another frame rate: the same walls, start and finish; the frame cap scaled with the rate.

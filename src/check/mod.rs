@@ -20,6 +20,7 @@ use crate::scene::expect::{ExpectController, ExpectQuality};
 use crate::scene::{self, Expectation, ExpectedRun, Limits, Scene};
 use crate::sim::controllers::{best_greedy, best_sharp_turning_greedy, GREEDY_LOOKAHEADS_UNITS};
 use crate::sim::{SideStrafer, Simulation};
+use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -477,109 +478,133 @@ pub fn measure(scene: &Scene, run: ExpectedRun) -> Result<Measured> {
 
 /// Every limit that `measured` breaks. A solve must be valid unless `valid = false` is given.
 pub fn compare(limits: &Limits, run: ExpectedRun, measured: &Measured) -> Vec<Failure> {
-    use serde_json::{json, Value};
-    let mut failures = Vec::new();
-    let not_reached = |figure: &'static str, limit: Value, shown: String| Failure {
+    [
+        frames_failure(limits, measured),
+        time_failure(limits, measured),
+        gap_failure(limits, measured),
+        validity_failure(limits, run, measured),
+        engine_exact_failure(limits, measured),
+        status_failure(limits, measured),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// A limit on `figure` broken by a run that never reached the finish line (`shown`: the limit as text).
+fn not_reached(figure: &'static str, limit: Value, shown: String) -> Failure {
+    Failure {
         figure,
         limit,
         actual: Value::Null,
         excess: None,
         message: format!("{figure}: the finish line was not reached, expected at most {shown}"),
-    };
-    if let Some(limit) = limits.frames {
-        match measured.frames {
-            None => failures.push(not_reached("frames", json!(limit), limit.to_string())),
-            Some(f) if f > limit => failures.push(Failure {
-                figure: "frames",
-                limit: json!(limit),
-                actual: json!(f),
-                excess: Some((f - limit) as f64),
-                message: format!(
-                    "frames {f} > {limit} (+{} frame{})",
-                    f - limit,
-                    if f - limit == 1 { "" } else { "s" }
-                ),
-            }),
-            Some(_) => {}
-        }
     }
-    if let Some(limit) = limits.time_s {
-        let tol = limits.time_tolerance_s;
-        match measured.time_s {
-            None => failures.push(not_reached("time", json!(limit), format!("{limit} s"))),
-            Some(t) if t > limit + tol => failures.push(Failure {
-                figure: "time",
-                limit: json!(limit),
-                actual: json!(t),
-                excess: Some(t - limit),
-                message: format!(
-                    "time {t:.6} s > {limit} s{} (+{:.6} s)",
-                    if tol > 0.0 {
-                        format!(" + {tol} s")
-                    } else {
-                        String::new()
-                    },
-                    t - limit
-                ),
-            }),
-            Some(_) => {}
-        }
+}
+
+/// More frames than the limit.
+fn frames_failure(limits: &Limits, measured: &Measured) -> Option<Failure> {
+    let limit = limits.frames?;
+    match measured.frames {
+        None => Some(not_reached("frames", json!(limit), limit.to_string())),
+        Some(f) if f > limit => Some(Failure {
+            figure: "frames",
+            limit: json!(limit),
+            actual: json!(f),
+            excess: Some((f - limit) as f64),
+            message: format!(
+                "frames {f} > {limit} (+{} frame{})",
+                f - limit,
+                if f - limit == 1 { "" } else { "s" }
+            ),
+        }),
+        Some(_) => None,
     }
-    if let Some(limit) = limits.gap_percent {
-        match measured.gap_percent {
-            None => failures.push(not_reached(
-                "gap-percent",
-                json!(limit),
-                format!("{limit}%"),
-            )),
-            Some(g) if g > limit => failures.push(Failure {
-                figure: "gap-percent",
-                limit: json!(limit),
-                actual: json!(g),
-                excess: Some(g - limit),
-                message: format!("gap {g:.3}% > {limit}% (+{:.3} points)", g - limit),
-            }),
-            Some(_) => {}
-        }
+}
+
+/// A crossing later than the limit and its tolerance, seconds.
+fn time_failure(limits: &Limits, measured: &Measured) -> Option<Failure> {
+    let limit = limits.time_s?;
+    let tol = limits.time_tolerance_s;
+    match measured.time_s {
+        None => Some(not_reached("time", json!(limit), format!("{limit} s"))),
+        Some(t) if t > limit + tol => Some(Failure {
+            figure: "time",
+            limit: json!(limit),
+            actual: json!(t),
+            excess: Some(t - limit),
+            message: format!(
+                "time {t:.6} s > {limit} s{} (+{:.6} s)",
+                if tol > 0.0 {
+                    format!(" + {tol} s")
+                } else {
+                    String::new()
+                },
+                t - limit
+            ),
+        }),
+        Some(_) => None,
     }
-    let must_be_valid = match run {
+}
+
+/// A gap to the lower bound above the limit, percent.
+fn gap_failure(limits: &Limits, measured: &Measured) -> Option<Failure> {
+    let limit = limits.gap_percent?;
+    match measured.gap_percent {
+        None => Some(not_reached(
+            "gap-percent",
+            json!(limit),
+            format!("{limit}%"),
+        )),
+        Some(g) if g > limit => Some(Failure {
+            figure: "gap-percent",
+            limit: json!(limit),
+            actual: json!(g),
+            excess: Some(g - limit),
+            message: format!("gap {g:.3}% > {limit}% (+{:.3} points)", g - limit),
+        }),
+        Some(_) => None,
+    }
+}
+
+/// Validity other than expected: a solve must be valid unless `valid = false` is given; a simulation
+/// only where `valid` is given.
+fn validity_failure(limits: &Limits, run: ExpectedRun, measured: &Measured) -> Option<Failure> {
+    let want = match run {
         ExpectedRun::Solve(_) => Some(limits.valid.unwrap_or(true)),
         ExpectedRun::Simulate(_) => limits.valid,
-    };
-    if let Some(want) = must_be_valid {
-        if measured.valid != want {
-            failures.push(Failure {
-                figure: "valid",
-                limit: json!(want),
-                actual: json!(measured.valid),
-                excess: None,
-                message: format!("valid {}, expected {want}", measured.valid),
-            });
-        }
-    }
-    if let (Some(want), Some(got)) = (limits.engine_exact_valid, measured.engine_exact_valid) {
-        if want != got {
-            failures.push(Failure {
-                figure: "engine-exact-valid",
-                limit: json!(want),
-                actual: json!(got),
-                excess: None,
-                message: format!("engine-exact valid {got}, expected {want}"),
-            });
-        }
-    }
-    if let (Some(allowed), Some(got)) = (&limits.status, &measured.status) {
-        if !allowed.contains(got) {
-            failures.push(Failure {
-                figure: "status",
-                limit: json!(allowed),
-                actual: json!(got),
-                excess: None,
-                message: format!("status {got}, expected {}", allowed.join(" or ")),
-            });
-        }
-    }
-    failures
+    }?;
+    (measured.valid != want).then(|| Failure {
+        figure: "valid",
+        limit: json!(want),
+        actual: json!(measured.valid),
+        excess: None,
+        message: format!("valid {}, expected {want}", measured.valid),
+    })
+}
+
+/// Engine-exact validity other than expected.
+fn engine_exact_failure(limits: &Limits, measured: &Measured) -> Option<Failure> {
+    let (want, got) = (limits.engine_exact_valid?, measured.engine_exact_valid?);
+    (want != got).then(|| Failure {
+        figure: "engine-exact-valid",
+        limit: json!(want),
+        actual: json!(got),
+        excess: None,
+        message: format!("engine-exact valid {got}, expected {want}"),
+    })
+}
+
+/// A status not among the allowed ones.
+fn status_failure(limits: &Limits, measured: &Measured) -> Option<Failure> {
+    let (allowed, got) = (limits.status.as_ref()?, measured.status.as_ref()?);
+    (!allowed.contains(got)).then(|| Failure {
+        figure: "status",
+        limit: json!(allowed),
+        actual: json!(got),
+        excess: None,
+        message: format!("status {got}, expected {}", allowed.join(" or ")),
+    })
 }
 
 /// The figures of a run in one short phrase: `frame 401, 4.001483 s, gap 0.562%, valid, engine-exact

@@ -111,6 +111,24 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     if !args.staircase.is_empty() {
         return super::bench_staircase::run(args);
     }
+    refuse_family_flags(args)?;
+    let settings = scene_settings(args)?;
+    let scenes = bench_scenes(args)?;
+    let rows = measured_rows(args, &scenes, &settings)?;
+    if let Some(path) = &args.svg {
+        write_atomically(path, |w| write_accuracy_svg(&rows, w))?;
+    }
+    if args.json {
+        let text = serde_json::to_string(&rows)
+            .map_err(|e| Error::Io(format!("serialising the rows: {e}")))?;
+        Ok(format!("{text}\n"))
+    } else {
+        Ok(table(&rows))
+    }
+}
+
+/// The flags of the generated family and its level, refused for scene files.
+fn refuse_family_flags(args: &BenchArgs) -> Result<()> {
     if args.quality.is_some() {
         return Err(Error::InvalidValue {
             name: "--quality".to_string(),
@@ -126,6 +144,12 @@ pub fn run(args: &BenchArgs) -> Result<String> {
             allowed: "given with --generated (it narrows the generated family)".to_string(),
         });
     }
+    Ok(())
+}
+
+/// The settings of a bench over scene files: the levels (in order, each once), the hill climber, its
+/// seed, and the limits.
+fn scene_settings(args: &BenchArgs) -> Result<BenchSettings> {
     let mut settings = BenchSettings {
         hill_climb: !args.no_hill_climb,
         ..BenchSettings::default()
@@ -158,6 +182,12 @@ pub fn run(args: &BenchArgs) -> Result<String> {
             "a finite number above 0",
         ));
     }
+    Ok(settings)
+}
+
+/// The scenes to measure (the given files, else the default set), each with its bend's width; every
+/// scene is loaded before anything is measured, so a bad file fails at once.
+fn bench_scenes(args: &BenchArgs) -> Result<Vec<(Scene, Option<f64>)>> {
     let paths: Vec<PathBuf> = if args.scenes.is_empty() {
         DEFAULT_SCENES
             .iter()
@@ -167,11 +197,19 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     } else {
         args.scenes.clone()
     };
-    // Every scene is loaded before anything is measured, so a bad file fails at once.
-    let scenes: Vec<(Scene, Option<f64>)> = paths
+    paths
         .iter()
         .map(|p| Scene::load(p).map(|s| (s, bend_width(p))))
-        .collect::<Result<_>>()?;
+        .collect()
+}
+
+/// Every scene measured at every level, then (unless `--quick` or `--no-scaling`) the first scene's
+/// frame-rate scaling.
+fn measured_rows(
+    args: &BenchArgs,
+    scenes: &[(Scene, Option<f64>)],
+    settings: &BenchSettings,
+) -> Result<Vec<BenchRow>> {
     let mut rows = Vec::new();
     let bar = progress::spinner(progress::wanted(args.json, args.quiet));
     bar.set_prefix("bench");
@@ -182,7 +220,7 @@ pub fn run(args: &BenchArgs) -> Result<String> {
             scenes.len(),
             scene.name
         ));
-        rows.extend(measure_scene(scene, *width, &settings)?);
+        rows.extend(measure_scene(scene, *width, settings)?);
     }
     if !(args.quick || args.no_scaling) {
         if let Some((scene, _)) = scenes.first() {
@@ -193,21 +231,12 @@ pub fn run(args: &BenchArgs) -> Result<String> {
                     super::solve::fps_text(args.scaling_fps)
                 ));
                 let q = settings.levels.first().copied().unwrap_or(Quality::Fast);
-                rows.extend(measure_scaling(scene, args.scaling_fps, q, &settings)?);
+                rows.extend(measure_scaling(scene, args.scaling_fps, q, settings)?);
             }
         }
     }
     bar.finish_and_clear();
-    if let Some(path) = &args.svg {
-        write_atomically(path, |w| write_accuracy_svg(&rows, w))?;
-    }
-    if args.json {
-        let text = serde_json::to_string(&rows)
-            .map_err(|e| Error::Io(format!("serialising the rows: {e}")))?;
-        Ok(format!("{text}\n"))
-    } else {
-        Ok(table(&rows))
-    }
+    Ok(rows)
 }
 
 fn opt<T>(v: Option<T>, f: impl Fn(T) -> String) -> String {

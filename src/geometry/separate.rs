@@ -5,7 +5,7 @@
 //! side keeps the whole straight move clear (a half-plane is convex).
 
 use super::corridor::Corridor;
-use super::grown::{move_box, PLANE_COUNT};
+use super::grown::{move_box, GrownSegment, PLANE_COUNT};
 use super::wall::BoundaryKind;
 use crate::physics::Vec2;
 
@@ -112,15 +112,7 @@ impl Corridor {
             if !g.box_near(lo, hi, 0.0) {
                 continue;
             }
-            // The least-deep face: the plane of the grown segment that both ends are furthest outside.
-            let (mut face, mut face_sep) = (0, f64::NEG_INFINITY);
-            for i in 0..PLANE_COUNT {
-                let sep = g.side(i, p0).min(g.side(i, p1));
-                if sep > face_sep {
-                    face_sep = sep;
-                    face = i;
-                }
-            }
+            let (face, face_sep) = least_deep_face(g, p0, p1);
             let face_plane = HalfPlane {
                 normal: g.planes[face].normal,
                 offset: g.planes[face].offset,
@@ -129,12 +121,12 @@ impl Corridor {
                 .open_interval(p0, p1 - p0, 0.0)
                 .is_some_and(|iv| iv.meets_unit_open())
                 || g.max_side(p0) < 0.0;
-            let end_param = if g.side(face, p0) <= g.side(face, p1) {
-                0.0
-            } else {
-                1.0
-            };
             let sep = if intersects {
+                let end_param = if g.side(face, p0) <= g.side(face, p1) {
+                    0.0
+                } else {
+                    1.0
+                };
                 Separation {
                     plane: face_plane,
                     clearance: face_sep.min(0.0),
@@ -142,44 +134,14 @@ impl Corridor {
                     move_param: end_param,
                 }
             } else {
-                let verts = g.vertices();
-                let n = verts.len();
-                let mut best = (f64::INFINITY, Vec2::ZERO, Vec2::ZERO);
-                for i in 0..n {
-                    let (x, y) = closest_segment_segment(p0, p1, verts[i], verts[(i + 1) % n]);
-                    let d = (x - y).length();
-                    if d < best.0 {
-                        best = (d, x, y);
-                    }
-                }
-                let (d, x, y) = best;
-                if d > radius_units {
-                    continue;
-                }
-                let mv = p1 - p0;
-                let t = if mv.length_squared() > 0.0 {
-                    ((x - p0).dot(mv) / mv.length_squared()).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                if d < DIRECTION_MIN_UNITS {
-                    Separation {
-                        plane: face_plane,
-                        clearance: d,
+                match nearest_separation(g, p0, p1, radius_units, face_plane) {
+                    Some((plane, clearance, move_param)) => Separation {
+                        plane,
+                        clearance,
                         wall: piece.wall,
-                        move_param: t,
-                    }
-                } else {
-                    let normal = (x - y) * (1.0 / d);
-                    Separation {
-                        plane: HalfPlane {
-                            normal,
-                            offset: normal.dot(y),
-                        },
-                        clearance: d,
-                        wall: piece.wall,
-                        move_param: t,
-                    }
+                        move_param,
+                    },
+                    None => continue,
                 }
             };
             out.push(sep);
@@ -195,6 +157,63 @@ impl Corridor {
             .map(|s| s.clearance)
             .fold(radius_units, f64::min)
     }
+}
+
+/// The least-deep face of `g` for the move `p0 -> p1`: the plane both ends are furthest outside, and
+/// how far (the smaller of the two ends' distances).
+#[inline]
+fn least_deep_face(g: &GrownSegment, p0: Vec2, p1: Vec2) -> (usize, f64) {
+    let (mut face, mut face_sep) = (0, f64::NEG_INFINITY);
+    for i in 0..PLANE_COUNT {
+        let sep = g.side(i, p0).min(g.side(i, p1));
+        if sep > face_sep {
+            face_sep = sep;
+            face = i;
+        }
+    }
+    (face, face_sep)
+}
+
+/// For a move `p0 -> p1` clear of `g`: the plane through the nearest point of `g`'s boundary normal to
+/// the gap (`face_plane` where the gap is too short to give a direction), the gap, and where along the
+/// move its nearest point lies; `None` when the gap is over `radius_units`.
+#[inline]
+fn nearest_separation(
+    g: &GrownSegment,
+    p0: Vec2,
+    p1: Vec2,
+    radius_units: f64,
+    face_plane: HalfPlane,
+) -> Option<(HalfPlane, f64, f64)> {
+    let verts = g.vertices();
+    let n = verts.len();
+    let mut best = (f64::INFINITY, Vec2::ZERO, Vec2::ZERO);
+    for i in 0..n {
+        let (x, y) = closest_segment_segment(p0, p1, verts[i], verts[(i + 1) % n]);
+        let d = (x - y).length();
+        if d < best.0 {
+            best = (d, x, y);
+        }
+    }
+    let (d, x, y) = best;
+    if d > radius_units {
+        return None;
+    }
+    let mv = p1 - p0;
+    let t = if mv.length_squared() > 0.0 {
+        ((x - p0).dot(mv) / mv.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    if d < DIRECTION_MIN_UNITS {
+        return Some((face_plane, d, t));
+    }
+    let normal = (x - y) * (1.0 / d);
+    let plane = HalfPlane {
+        normal,
+        offset: normal.dot(y),
+    };
+    Some((plane, d, t))
 }
 
 #[cfg(test)]

@@ -263,80 +263,70 @@ impl GeneratorSettings {
 
     /// Checks every range; the error names the field (`max_corners`) and what is allowed.
     pub fn validate(&self) -> Result<()> {
-        let range = |name: &str, lo: u32, hi: u32, floor: u32, ceil: u32| -> Result<()> {
-            for (which, v) in [("min", lo), ("max", hi)] {
-                if !(floor..=ceil).contains(&v) {
-                    return Err(Error::invalid(
-                        format!("{which}_{name}"),
-                        f64::from(v),
-                        format!("from {floor} to {ceil}"),
-                    ));
-                }
-            }
-            if lo > hi {
-                return Err(Error::invalid(
-                    format!("min_{name}"),
-                    f64::from(lo),
-                    format!("at most max_{name} ({hi})"),
-                ));
-            }
-            Ok(())
-        };
-        range(
-            "corners",
-            self.min_corners,
-            self.max_corners,
-            1,
-            MAX_CORNERS,
-        )?;
-        range("turn_deg", self.min_turn_deg, self.max_turn_deg, 1, 180)?;
-        range(
-            "width_units",
-            self.min_width_units,
-            self.max_width_units,
-            MIN_WIDTH_UNITS,
-            MAX_WIDTH_UNITS,
-        )?;
-        range(
-            "leg_units",
-            self.min_leg_units,
-            self.max_leg_units,
-            MIN_LEG_UNITS,
-            MAX_LEG_UNITS,
-        )?;
-        range(
-            "start_speed_ups",
-            self.min_start_speed_ups,
-            self.max_start_speed_ups,
-            0,
-            MAX_START_SPEED_UPS,
-        )?;
-        range(
-            "ground_start_speed_ups",
-            self.min_ground_start_speed_ups,
-            self.max_ground_start_speed_ups,
-            0,
-            MAX_START_SPEED_UPS,
-        )?;
-        let list = |name: &str, values: &[u32], allowed: &std::ops::RangeInclusive<u32>| {
-            if values.is_empty() {
-                return Err(Error::InvalidValue {
-                    name: name.to_string(),
-                    value: "an empty list".to_string(),
-                    allowed: "at least one value".to_string(),
-                });
-            }
-            match values.iter().find(|v| !allowed.contains(v)) {
-                Some(&v) => Err(Error::invalid(
-                    name,
-                    f64::from(v),
-                    format!("from {} to {}", allowed.start(), allowed.end()),
-                )),
-                None => Ok(()),
-            }
-        };
-        list("fps", &self.fps, &FPS_RANGE)?;
-        list("airaccelerate", &self.airaccelerate, &AIRACCELERATE_RANGE)?;
+        self.check_ranges()?;
+        check_list("fps", &self.fps, &FPS_RANGE)?;
+        check_list("airaccelerate", &self.airaccelerate, &AIRACCELERATE_RANGE)?;
+        self.check_kinds()?;
+        if !(1..=256).contains(&self.wall_gap_units) {
+            return Err(Error::invalid(
+                "wall_gap_units",
+                f64::from(self.wall_gap_units),
+                "from 1 to 256",
+            ));
+        }
+        if self.max_corridor_draws == 0 {
+            return Err(Error::invalid("max_corridor_draws", 0.0, "at least 1"));
+        }
+        Ok(())
+    }
+
+    /// Each `min_`/`max_` pair within its allowed range and in order.
+    fn check_ranges(&self) -> Result<()> {
+        let pairs = [
+            (
+                "corners",
+                self.min_corners,
+                self.max_corners,
+                1,
+                MAX_CORNERS,
+            ),
+            ("turn_deg", self.min_turn_deg, self.max_turn_deg, 1, 180),
+            (
+                "width_units",
+                self.min_width_units,
+                self.max_width_units,
+                MIN_WIDTH_UNITS,
+                MAX_WIDTH_UNITS,
+            ),
+            (
+                "leg_units",
+                self.min_leg_units,
+                self.max_leg_units,
+                MIN_LEG_UNITS,
+                MAX_LEG_UNITS,
+            ),
+            (
+                "start_speed_ups",
+                self.min_start_speed_ups,
+                self.max_start_speed_ups,
+                0,
+                MAX_START_SPEED_UPS,
+            ),
+            (
+                "ground_start_speed_ups",
+                self.min_ground_start_speed_ups,
+                self.max_ground_start_speed_ups,
+                0,
+                MAX_START_SPEED_UPS,
+            ),
+        ];
+        pairs
+            .into_iter()
+            .try_for_each(|(name, lo, hi, floor, ceil)| check_range(name, lo, hi, floor, ceil))
+    }
+
+    /// The wall kinds and scene kinds, each at least one.
+    fn check_kinds(&self) -> Result<()> {
         if self.wall_kinds.is_empty() {
             return Err(Error::InvalidValue {
                 name: "wall_kinds".to_string(),
@@ -350,16 +340,6 @@ impl GeneratorSettings {
                 value: "an empty list".to_string(),
                 allowed: "one or more of air, ground, bhop, hl2".to_string(),
             });
-        }
-        if !(1..=256).contains(&self.wall_gap_units) {
-            return Err(Error::invalid(
-                "wall_gap_units",
-                f64::from(self.wall_gap_units),
-                "from 1 to 256",
-            ));
-        }
-        if self.max_corridor_draws == 0 {
-            return Err(Error::invalid("max_corridor_draws", 0.0, "at least 1"));
         }
         Ok(())
     }
@@ -735,6 +715,46 @@ fn scene_text(
         points.join(",\n    ")
     );
     s
+}
+
+/// `min_NAME = lo` and `max_NAME = hi` each within `floor..=ceil`, and `lo <= hi`.
+fn check_range(name: &str, lo: u32, hi: u32, floor: u32, ceil: u32) -> Result<()> {
+    for (which, v) in [("min", lo), ("max", hi)] {
+        if !(floor..=ceil).contains(&v) {
+            return Err(Error::invalid(
+                format!("{which}_{name}"),
+                f64::from(v),
+                format!("from {floor} to {ceil}"),
+            ));
+        }
+    }
+    if lo > hi {
+        return Err(Error::invalid(
+            format!("min_{name}"),
+            f64::from(lo),
+            format!("at most max_{name} ({hi})"),
+        ));
+    }
+    Ok(())
+}
+
+/// A list of values `name`, not empty and each in `allowed`.
+fn check_list(name: &str, values: &[u32], allowed: &std::ops::RangeInclusive<u32>) -> Result<()> {
+    if values.is_empty() {
+        return Err(Error::InvalidValue {
+            name: name.to_string(),
+            value: "an empty list".to_string(),
+            allowed: "at least one value".to_string(),
+        });
+    }
+    match values.iter().find(|v| !allowed.contains(v)) {
+        Some(&v) => Err(Error::invalid(
+            name,
+            f64::from(v),
+            format!("from {} to {}", allowed.start(), allowed.end()),
+        )),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
