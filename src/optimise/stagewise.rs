@@ -1253,6 +1253,31 @@ mod tests {
     }
 
     #[test]
+    fn the_nearest_boundary_is_the_least_ratio_of_the_falling_entries_at_every_length() {
+        // Four running minima and a remainder: every length from none to three chunks and a rest,
+        // entries falling, rising and still, and the one nearest anywhere in the list.
+        let mut next = numbers(19);
+        for len in 0..=15 {
+            for _ in 0..20 {
+                let x: Vec<f64> = (0..len).map(|_| 2.0 + 2.0 * next()).collect();
+                let d: Vec<f64> = (0..len)
+                    .map(|_| match next() {
+                        r if r < -0.8 => 0.0,
+                        r => r,
+                    })
+                    .collect();
+                let naive = x
+                    .iter()
+                    .zip(&d)
+                    .filter(|(_, &d)| d < 0.0)
+                    .map(|(&x, &d)| -x / d)
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(nearest_boundary(&x, &d), naive, "{x:?} {d:?}");
+            }
+        }
+    }
+
+    #[test]
     fn a_bound_row_adds_and_reads_as_the_full_row_it_stands_for() {
         // The bound rows take a short way in `add_to` and `row_value`; the row written out in full
         // (its one entry in `d`, no `bound`) must give the same numbers.
