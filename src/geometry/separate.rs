@@ -134,13 +134,9 @@ impl Corridor {
                     move_param: end_param,
                 }
             } else {
-                match nearest_separation(g, p0, p1, radius_units, face_plane) {
-                    Some((plane, clearance, move_param)) => Separation {
-                        plane,
-                        clearance,
-                        wall: piece.wall,
-                        move_param,
-                    },
+                let near = nearest_separation(g, p0, p1, radius_units, face_plane, piece.wall);
+                match near {
+                    Some(sep) => sep,
                     None => continue,
                 }
             };
@@ -174,9 +170,10 @@ fn least_deep_face(g: &GrownSegment, p0: Vec2, p1: Vec2) -> (usize, f64) {
     (face, face_sep)
 }
 
-/// For a move `p0 -> p1` clear of `g`: the plane through the nearest point of `g`'s boundary normal to
-/// the gap (`face_plane` where the gap is too short to give a direction), the gap, and where along the
-/// move its nearest point lies; `None` when the gap is over `radius_units`.
+/// The separation of a move `p0 -> p1` clear of `g` (wall `wall`): the plane through the nearest point
+/// of `g`'s boundary normal to the gap (`face_plane` where the gap is too short to give a direction),
+/// the gap as its clearance, and where along the move its nearest point lies; `None` when the gap is
+/// over `radius_units`.
 #[inline]
 fn nearest_separation(
     g: &GrownSegment,
@@ -184,7 +181,8 @@ fn nearest_separation(
     p1: Vec2,
     radius_units: f64,
     face_plane: HalfPlane,
-) -> Option<(HalfPlane, f64, f64)> {
+    wall: usize,
+) -> Option<Separation> {
     let verts = g.vertices();
     let n = verts.len();
     let mut best = (f64::INFINITY, Vec2::ZERO, Vec2::ZERO);
@@ -205,15 +203,21 @@ fn nearest_separation(
     } else {
         0.0
     };
-    if d < DIRECTION_MIN_UNITS {
-        return Some((face_plane, d, t));
-    }
-    let normal = (x - y) * (1.0 / d);
-    let plane = HalfPlane {
-        normal,
-        offset: normal.dot(y),
+    let plane = if d < DIRECTION_MIN_UNITS {
+        face_plane
+    } else {
+        let normal = (x - y) * (1.0 / d);
+        HalfPlane {
+            normal,
+            offset: normal.dot(y),
+        }
     };
-    Some((plane, d, t))
+    Some(Separation {
+        plane,
+        clearance: d,
+        wall,
+        move_param: t,
+    })
 }
 
 #[cfg(test)]

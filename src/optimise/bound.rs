@@ -326,11 +326,12 @@ fn first_ground_and_standing(
     let mut s = scene.start;
     let mut first_ground = None;
     let mut standing_from = if s.ducked { None } else { Some(1) };
+    let idle = idle_forward();
     for frame in 1..=probe_frames {
         if s.on_ground && first_ground.is_none() {
             first_ground = Some(frame);
         }
-        stepper.step(&mut s, &idle_forward());
+        stepper.step(&mut s, &idle);
         if !s.ducked && standing_from.is_none() {
             standing_from = Some(frame);
         }

@@ -372,12 +372,11 @@ fn stage_at_count(
 ) -> CountTried {
     planner.stats.frame_counts_tried += 1;
     let relaxed_iters = planner.settings.relaxed_iters;
-    let pr = relaxed_problem(planner, relaxation, frames_per_knot);
-    let (c, capped) = planner.stage(pr, controls.to_vec(), relaxed_iters);
+    let problem = relaxed_problem(planner, relaxation, frames_per_knot);
+    let (c, capped) = planner.stage(problem.clone(), controls.to_vec(), relaxed_iters);
     planner.note_cut(Stage::Relaxed);
     let states = rollout_knots(&planner.start, &c, &planner.fl, frames_per_knot);
     let reached = model_crossing(&planner.start, &states, planner.scene);
-    let problem = relaxed_problem(planner, relaxation, frames_per_knot);
     let clean = problem.violation(&states) <= super::scp::CLEAN_VIOLATION_UNITS;
     let crossing = reached.filter(|_| clean);
     let per = frames_per_knot as usize;

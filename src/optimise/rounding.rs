@@ -3,6 +3,7 @@
 
 use super::model::{anglemod_step_ups, frame, rollout, FrameControl, FrameLaw, ModelState};
 use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
+use crate::physics::Vec2;
 
 /// How far ahead a heading error is weighed by the side rounding, seconds.
 pub(super) const ROUNDING_HORIZON_S: f64 = 0.05;
@@ -84,7 +85,7 @@ pub(super) fn round_sides_trimmed(
         let saturated = held_s[k] > 0.0 || next_run_s > 0.0;
         let target = Target {
             relaxed: relaxed[k],
-            normal: crate::physics::Vec2::from_angle(relaxed[k].heading).perp(),
+            normal: Vec2::from_angle(relaxed[k].heading).perp(),
             held_s: horizon_s.max(next_run_s),
             remaining_s: (frames - k - 1) as f64 * fl.tau_s,
         };
@@ -121,7 +122,7 @@ pub(super) fn round_sides_trimmed(
 /// its heading, how long a heading error is held ([`round_sides`]) and the plan's time left after it.
 struct Target {
     relaxed: ModelState,
-    normal: crate::physics::Vec2,
+    normal: Vec2,
     held_s: f64,
     remaining_s: f64,
 }

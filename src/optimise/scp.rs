@@ -39,6 +39,7 @@ use std::time::{Duration, Instant};
 
 /// The problem argmin sees: the plan's parameters `(sigma_0, c_0, sigma_1, c_1, ...)` and, as cost, minus
 /// the merit `progress - weight * violation`.
+#[derive(Clone)]
 pub struct ScpProblem<'a> {
     pub(super) start: ModelState,
     pub(super) fl: FrameLaw,

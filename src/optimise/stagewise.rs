@@ -1253,26 +1253,54 @@ mod tests {
     }
 
     #[test]
-    fn the_nearest_boundary_is_the_least_ratio_of_the_falling_entries_at_every_length() {
+    fn the_step_to_the_boundary_is_the_least_scaled_ratio_of_the_falling_entries_at_every_length() {
         // Four running minima and a remainder: every length from none to three chunks and a rest,
-        // entries falling, rising and still, and the one nearest anywhere in the list.
+        // entries falling, rising and still, and the one nearest anywhere in the list; the share
+        // applied to the least ratio must give what it gives applied to each, capped at a full step.
         let mut next = numbers(19);
+        let mut entries = |len: usize| -> (Vec<f64>, Vec<f64>) {
+            let x: Vec<f64> = (0..len).map(|_| 0.1 + 2.0 * (1.0 + next())).collect();
+            let d: Vec<f64> = (0..len)
+                .map(|_| match next() {
+                    r if r < -0.8 => 0.0,
+                    r => 4.0 * r,
+                })
+                .collect();
+            (x, d)
+        };
         for len in 0..=15 {
             for _ in 0..20 {
-                let x: Vec<f64> = (0..len).map(|_| 2.0 + 2.0 * next()).collect();
-                let d: Vec<f64> = (0..len)
-                    .map(|_| match next() {
-                        r if r < -0.8 => 0.0,
-                        r => r,
-                    })
-                    .collect();
-                let naive = x
+                let (t, dt) = entries(len);
+                let (lambda, dlambda) = entries(len);
+                let naive = t
                     .iter()
-                    .zip(&d)
+                    .zip(&dt)
                     .filter(|(_, &d)| d < 0.0)
                     .map(|(&x, &d)| -x / d)
                     .fold(f64::INFINITY, f64::min);
-                assert_eq!(nearest_boundary(&x, &d), naive, "{x:?} {d:?}");
+                assert_eq!(nearest_boundary(&t, &dt), naive, "{t:?} {dt:?}");
+                let it = Iterate {
+                    v: Vec::new(),
+                    dx: Vec::new(),
+                    t: t.clone(),
+                    lambda: lambda.clone(),
+                    rp: Vec::new(),
+                    grad: Vec::new(),
+                };
+                let dir = Direction {
+                    dt: dt.clone(),
+                    dlambda: dlambda.clone(),
+                    ..Direction::default()
+                };
+                for share in [1.0, STEP_TO_BOUNDARY] {
+                    let mut each = 1.0_f64;
+                    for (x, d) in t.iter().zip(&dt).chain(lambda.iter().zip(&dlambda)) {
+                        if *d < 0.0 {
+                            each = each.min(share * (-x / d));
+                        }
+                    }
+                    assert_eq!(step_to_boundary(&it, &dir, share), each, "{t:?} {dt:?}");
+                }
             }
         }
     }
