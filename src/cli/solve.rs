@@ -38,12 +38,17 @@ pub fn run(args: &SolveArgs) -> Result<String> {
             bar.set_prefix(Stage::Relaxed.name());
             bar.set_message(p.to_string());
         }
-        Progress::FrameCount { frames, reached } => {
+        Progress::FrameCount {
+            frames,
+            frames_per_step,
+            reached,
+        } => {
             // The count of counts tried so far, which the report itself does not carry.
             counts_tried += 1;
             bar.set_prefix(Stage::Relaxed.name());
             bar.set_message(format!(
-                "frame counts tried {counts_tried}, last {frames}: {}",
+                "frame counts tried {counts_tried}, last {frames}{}: {}",
+                Progress::steps_text(frames_per_step),
                 Progress::crossing_text(reached)
             ));
         }

@@ -2,9 +2,10 @@
 //! [`super::model`]), so that every exact plan is one of its points. Min-time is fixed-N maximal progress
 //! plus a search over N: SCP at a frame count N, then N lowered to the frame before the plan's crossing
 //! until the line can no longer be reached. On long runs (and on the certificate's greedy starts of 200
-//! frames or more) the search first runs over knots of several frames played with one control (coarse to
-//! fine), each the mean of its frames' controls or, where those knots run into the walls, fitted to
-//! follow the start's run.
+//! frames or more) the search first runs over knots of several frames played with one control, each the
+//! mean of its frames' controls or, where those knots run into the walls, fitted to follow the start's
+//! run; when a knot stage stops, over knots half as long from its line, down to knots of 2 or 3 frames
+//! (coarse to fine), then frame by frame.
 
 use super::model::{
     frame, knots_averaged, knots_following, rollout_knots, FrameControl, FrameLaw, ModelState,
@@ -166,7 +167,8 @@ pub(super) fn coarse_knot_frames(frames: usize, runs: CoarseRuns) -> u32 {
 
 /// The relaxed plan at wall `margin` (units) from the warm start `controls`, whose line crossing is near
 /// frame `n`; no plan crosses before frame `lo` (the lower bound's). Coarse to fine on the `descent`'s
-/// coarse runs. Returns the search over frames: its best clean plan, cut at its crossing frame.
+/// coarse runs: over knots, halved each time a knot stage stops on a line ([`finer_knot_frames`]), then
+/// frames. Returns the search over frames: its best clean plan, cut at its crossing frame.
 pub(super) fn relaxed_plan(
     planner: &mut Planner,
     progress: &mut dyn FnMut(Progress),
@@ -176,49 +178,86 @@ pub(super) fn relaxed_plan(
     relaxation: Relaxation,
     descent: Descent,
 ) -> Descended {
-    let knot_frames = coarse_knot_frames(n, descent.coarse);
-    if knot_frames > 1 {
+    let mut knot_frames = coarse_knot_frames(n, descent.coarse);
+    // Whether some knots' start was fitted to the run, and whether the last knots reached a line.
+    let mut fitted_any = false;
+    let mut reached = true;
+    while knot_frames > 1 {
         let m = knot_frames as usize;
-        // The chord of a knot leaves its frames' arc by at most the sagitta m^2 tau gamma1 / 8 (each frame
-        // turns the heading by at most about gamma1 / V).
-        let fl = planner.fl;
-        let sagitta = (m * m) as f64 * fl.tau_s * fl.law.gamma1 / 8.0;
-        let over_knots = Relaxation {
-            margin_units: relaxation.margin_units + sagitta,
-            ..relaxation
-        };
-        let (knots, fitted) =
-            coarse_start(planner, &controls[..n.min(controls.len())], m, over_knots);
-        let count = knots.len();
-        let knots_line = count_search(
+        let (knots_line, fitted) = knots_descent(
             planner,
             progress,
-            knots,
-            count,
-            lo / m,
-            descent.count_search(over_knots, knot_frames),
-        )
-        .line;
-        let reached = knots_line.is_some();
-        if let Some(plan) = knots_line {
-            controls = plan
-                .iter()
-                .flat_map(|u| std::iter::repeat_n(*u, m))
-                .collect();
-            n = controls.len();
-        }
-        if let Some(first) = descent.after_unclear_knots.filter(|_| fitted || !reached) {
-            let search = descent.count_search(first, 1);
-            if let Some(line) =
-                count_search(planner, progress, controls.clone(), n, lo, search).line
-            {
-                n = line.len();
-                controls = line;
-            }
+            &controls[..n.min(controls.len())],
+            lo,
+            m,
+            relaxation,
+            descent,
+        );
+        fitted_any |= fitted;
+        reached = knots_line.is_some();
+        let Some(plan) = knots_line else { break };
+        controls = plan
+            .iter()
+            .flat_map(|u| std::iter::repeat_n(*u, m))
+            .collect();
+        n = controls.len();
+        knot_frames = finer_knot_frames(knot_frames);
+    }
+    if let Some(first) = descent
+        .after_unclear_knots
+        .filter(|_| fitted_any || !reached)
+    {
+        let search = descent.count_search(first, 1);
+        if let Some(line) = count_search(planner, progress, controls.clone(), n, lo, search).line {
+            n = line.len();
+            controls = line;
         }
     }
     let per_frame = descent.count_search(relaxation, 1);
     count_search(planner, progress, controls, n, lo, per_frame)
+}
+
+/// Frames per knot of the stage that follows a knot stage of `frames_per_knot` once its line stops: half
+/// as many, down to knots of 2 or 3 frames; after those, 1 (frame by frame). A knot stage stops where one
+/// control per knot, kept a sagitta (`m^2 tau gamma1 / 8`) off the walls, can turn the line no sooner.
+/// Knots half as long go on from that line at a quarter of the sagitta, each of their sub-problems a
+/// fraction of the price of a frame-by-frame one, where the frames alone gain a few frames a count from
+/// far above their line.
+fn finer_knot_frames(frames_per_knot: u32) -> u32 {
+    if frames_per_knot >= 4 {
+        frames_per_knot / 2
+    } else {
+        1
+    }
+}
+
+/// The count search over knots of `frames_per_knot` frames from the run of `controls`, at `relaxation`'s
+/// margin widened by the knots' sagitta: the line it reaches (cut at its crossing knot), and whether its
+/// start had to be fitted to the run ([`coarse_start`]).
+fn knots_descent(
+    planner: &mut Planner,
+    progress: &mut dyn FnMut(Progress),
+    controls: &[FrameControl],
+    lo: usize,
+    frames_per_knot: usize,
+    relaxation: Relaxation,
+    descent: Descent,
+) -> (Option<Vec<FrameControl>>, bool) {
+    let m = frames_per_knot;
+    // The chord of a knot leaves its frames' arc by at most the sagitta m^2 tau gamma1 / 8 (each frame
+    // turns the heading by at most about gamma1 / V).
+    let fl = planner.fl;
+    let sagitta = (m * m) as f64 * fl.tau_s * fl.law.gamma1 / 8.0;
+    let over_knots = Relaxation {
+        margin_units: relaxation.margin_units + sagitta,
+        ..relaxation
+    };
+    let (knots, fitted) = coarse_start(planner, controls, m, over_knots);
+    let count = knots.len();
+    let per = u32::try_from(m).unwrap_or(u32::MAX);
+    let search = descent.count_search(over_knots, per);
+    let line = count_search(planner, progress, knots, count, lo / m, search).line;
+    (line, fitted)
 }
 
 /// The knots of `frames_per_knot` frames a coarse stage at `relaxation` starts from, for the run of
@@ -382,6 +421,7 @@ fn stage_at_count(
     let per = frames_per_knot as usize;
     progress(Progress::FrameCount {
         frames: controls.len() * per,
+        frames_per_step: frames_per_knot,
         reached: crossing.map(|k| k * per),
     });
     CountTried {
@@ -1081,11 +1121,40 @@ mod tests {
     ) -> Vec<(usize, Option<usize>)> {
         let mut counts = Vec::new();
         search(&mut |p| {
-            if let Progress::FrameCount { frames, reached } = p {
+            if let Progress::FrameCount {
+                frames, reached, ..
+            } = p
+            {
                 counts.push((frames, reached));
             }
         });
         counts
+    }
+
+    /// A stage of a descent as it reports it: its planning step (frames per knot) with the counts tried
+    /// over it, in frames, each with the frame its line crosses in where it reaches the line cleanly.
+    type StageTried = (u32, Vec<(usize, Option<usize>)>);
+
+    /// The stages of a descent as it reports them ([`StageTried`]); consecutive counts over the same step
+    /// are one stage.
+    fn stages_tried(search: impl FnOnce(&mut dyn FnMut(Progress))) -> Vec<StageTried> {
+        let mut stages: Vec<StageTried> = Vec::new();
+        search(&mut |p| {
+            if let Progress::FrameCount {
+                frames,
+                frames_per_step,
+                reached,
+            } = p
+            {
+                match stages.last_mut() {
+                    Some((step, counts)) if *step == frames_per_step => {
+                        counts.push((frames, reached));
+                    }
+                    _ => stages.push((frames_per_step, vec![(frames, reached)])),
+                }
+            }
+        });
+        stages
     }
 
     /// The frame counts a search reports as it tries them ([`counts_and_crossings`]).
@@ -1122,6 +1191,63 @@ mod tests {
             count_search(&mut planner, record, half, n, 0, search);
         });
         assert!(grown.iter().any(|&c| c > n), "{grown:?} against {n}");
+    }
+
+    #[test]
+    fn a_knot_stage_that_stops_hands_its_line_to_knots_half_as_long() {
+        // A four-corner staircase's greedy seed (about 500 frames at 100 fps) as a certificate's greedy
+        // start: knots of about five frames, then two, then frames, each stage from the line the one
+        // before stopped at.
+        let scene = staircase_scene(4);
+        let settings = SearchSettings::for_quality(Quality::Fast);
+        let stages = with_planner(&scene, &settings, |planner, base, _| {
+            let warm = planner.warm_start(base.seed());
+            let n = warm.len();
+            let planning = Relaxation::planning(planning_margin(planner));
+            let first = coarse_knot_frames(n, CoarseRuns::AlsoShort);
+            let stages = stages_tried(|record| {
+                let descent = Descent::greedy_start(planning);
+                relaxed_plan(
+                    planner,
+                    record,
+                    warm,
+                    n,
+                    0,
+                    Relaxation::certificate(),
+                    descent,
+                );
+            });
+            let mut steps = vec![first];
+            while let Some(&last) = steps.last().filter(|&&s| s > 1) {
+                steps.push(finer_knot_frames(last));
+            }
+            (steps, stages)
+        });
+        let (steps, stages) = stages;
+        assert!(steps.len() >= 3, "{steps:?}");
+        let tried: Vec<u32> = stages.iter().map(|s| s.0).collect();
+        assert_eq!(tried, steps, "{stages:?}");
+        let best = |counts: &[(usize, Option<usize>)]| counts.iter().filter_map(|c| c.1).min();
+        for pair in stages.windows(2) {
+            let [(coarse, coarser), (fine, finer)] = pair else {
+                unreachable!()
+            };
+            let Some(line) = best(coarser) else {
+                panic!("knots of {coarse} reached no line: {coarser:?}")
+            };
+            // The finer stage starts from the coarser line (its last knot may run on a few frames past
+            // it), and ends no later.
+            let start = finer.first().map_or(0, |c| c.0);
+            let fine = *fine as usize;
+            assert!(
+                start >= line && start < line + fine,
+                "{coarse} -> {fine}: {start} from {line}"
+            );
+            assert!(
+                best(finer).is_some_and(|b| b <= line),
+                "{coarse} -> {fine}: {finer:?}"
+            );
+        }
     }
 
     #[test]

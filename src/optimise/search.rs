@@ -391,6 +391,9 @@ pub enum Progress {
     FrameCount {
         /// The frame count.
         frames: usize,
+        /// Frames per planning step: 1 frame by frame, more over knots (one control held for that many
+        /// frames), the coarse stages of a long run.
+        frames_per_step: u32,
         /// The frame in which that plan crosses the line, if it does without touching a wall.
         reached: Option<usize>,
     },
@@ -404,6 +407,16 @@ pub enum Progress {
 }
 
 impl Progress {
+    /// The planning step of a tried frame count, in words (`frames_per_step` of
+    /// [`Progress::FrameCount`]): nothing frame by frame.
+    pub fn steps_text(frames_per_step: u32) -> String {
+        if frames_per_step > 1 {
+            format!(" over knots of {frames_per_step}")
+        } else {
+            String::new()
+        }
+    }
+
     /// Where a tried frame count's plan crosses the line, in words (`reached` of
     /// [`Progress::FrameCount`]).
     pub fn crossing_text(reached: Option<usize>) -> String {
@@ -425,10 +438,15 @@ impl std::fmt::Display for Progress {
                     greedy_frames.map_or("did not finish".to_string(), |g| format!("frame {g}"));
                 write!(f, "greedy {greedy}, lower bound frame {bound_frames}")
             }
-            Progress::FrameCount { frames, reached } => {
+            Progress::FrameCount {
+                frames,
+                frames_per_step,
+                reached,
+            } => {
                 write!(
                     f,
-                    "trying {frames} frames: {}",
+                    "trying {frames} frames{}: {}",
+                    Progress::steps_text(*frames_per_step),
                     Progress::crossing_text(*reached)
                 )
             }
@@ -759,11 +777,18 @@ mod tests {
             },
             Progress::FrameCount {
                 frames: 405,
+                frames_per_step: 1,
                 reached: Some(403),
             },
             Progress::FrameCount {
                 frames: 402,
+                frames_per_step: 1,
                 reached: None,
+            },
+            Progress::FrameCount {
+                frames: 2358,
+                frames_per_step: 3,
+                reached: Some(2358),
             },
             Progress::Finishing,
             Progress::Polishing {
@@ -778,6 +803,7 @@ mod tests {
                 "greedy did not finish, lower bound frame 398",
                 "trying 405 frames: crosses in frame 403",
                 "trying 402 frames: not reached",
+                "trying 2358 frames over knots of 3: crosses in frame 2358",
                 "rounding sides, polishing, checking in engine-exact mode",
                 "polishing the plan on at a wall margin of 0.002 units",
             ]
