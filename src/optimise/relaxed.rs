@@ -313,22 +313,10 @@ pub(super) fn count_search<'a>(
     lo: usize,
     search: CountSearch,
 ) -> Descended {
-    let CountSearch {
-        relaxation,
-        frames_per_knot,
-        grow_tries: max_grow_tries,
-    } = search;
     let fl = planner.fl;
-    let max_returns = planner.settings.capped_line_returns;
+    let mut counts = CountsSoFar::new(lo, search.grow_tries, planner.settings.capped_line_returns);
     // A sub-problem has at least one step to plan (an empty one is no problem for the solver).
     n = n.max(1);
-    let mut best: Option<Vec<FrameControl>> = None;
-    let mut grow_tries = 0;
-    let mut continue_tries = 0;
-    // Whether the stage that found `best` stopped at its iteration cap, and the times the search went
-    // back to it.
-    let mut best_capped = false;
-    let mut returns = 0;
     let short = loop {
         if planner.out_of_time() {
             planner.note_cut(Stage::Relaxed);
@@ -341,55 +329,136 @@ pub(super) fn count_search<'a>(
                 c: fl.c_max(f64::INFINITY),
             },
         );
+        let tried = stage_at_count(
+            planner,
+            progress,
+            &controls,
+            search.relaxation,
+            search.frames_per_knot,
+        );
+        match counts.next(tried, n, planner.timed_out) {
+            NextCount::Try {
+                steps,
+                controls: start,
+            } => {
+                n = steps;
+                controls = start;
+            }
+            NextCount::Stop { short } => break short,
+        }
+    };
+    Descended {
+        line: counts.best,
+        short,
+    }
+}
+
+/// What a count search does after a count: try `steps` planning steps from `controls`, or stop
+/// (`short`: see [`Descended::short`]).
+enum NextCount {
+    Try {
+        steps: usize,
+        controls: Vec<FrameControl>,
+    },
+    Stop {
+        short: bool,
+    },
+}
+
+/// A count search between counts ([`count_search`]): its best clean line so far and the times it went on
+/// without descending, each against its limit.
+struct CountsSoFar {
+    /// The best clean line, cut at its crossing step.
+    best: Option<Vec<FrameControl>>,
+    /// Whether the stage that found `best` stopped at its iteration cap.
+    best_capped: bool,
+    /// No line crosses before this step (the bound's).
+    lo: usize,
+    /// Times an unreachable count was grown, and the most allowed.
+    grow_tries: usize,
+    max_grow_tries: usize,
+    /// Times a capped stage was continued at its own count (at most [`MAX_CONTINUED_STAGES`]).
+    continue_tries: usize,
+    /// Times the search went back to a line its capped stage left improving, and the most allowed.
+    returns: usize,
+    max_returns: usize,
+}
+
+impl CountsSoFar {
+    fn new(lo: usize, max_grow_tries: usize, max_returns: usize) -> Self {
+        CountsSoFar {
+            best: None,
+            best_capped: false,
+            lo,
+            grow_tries: 0,
+            max_grow_tries,
+            continue_tries: 0,
+            returns: 0,
+            max_returns,
+        }
+    }
+
+    /// The next count after `tried` at `n` steps (`timed_out`: the solve's budget is spent).
+    fn next(&mut self, tried: CountTried, n: usize, timed_out: bool) -> NextCount {
         let CountTried {
             controls: c,
             capped,
             crossing,
-        } = stage_at_count(planner, progress, &controls, relaxation, frames_per_knot);
+        } = tried;
         match crossing {
             Some(k) => {
-                best = Some(c[..k].to_vec());
-                best_capped = capped;
+                self.best = Some(c[..k].to_vec());
+                self.best_capped = capped;
                 // One step short of this plan's crossing, warm-started from it: each solve keeps
                 // improving the same line (stepping further on a failed probe proves nothing, the
                 // search being local).
-                if k <= lo + 1 || planner.timed_out {
-                    break planner.timed_out;
+                if k <= self.lo + 1 || timed_out {
+                    return NextCount::Stop { short: timed_out };
                 }
-                n = k - 1;
-                controls = c[..n].to_vec();
+                NextCount::Try {
+                    steps: k - 1,
+                    controls: c[..k - 1].to_vec(),
+                }
             }
-            _ if capped && continue_tries < MAX_CONTINUED_STAGES && !planner.timed_out => {
+            _ if capped && self.continue_tries < MAX_CONTINUED_STAGES && !timed_out => {
                 // The stage ran out of iterations still improving (a start far from the line: the
                 // capped greedy run of a narrow bend at 1000 fps): go on at the same count.
-                continue_tries += 1;
-                controls = c;
+                self.continue_tries += 1;
+                NextCount::Try {
+                    steps: n,
+                    controls: c,
+                }
             }
-            _ if best_capped && returns < max_returns && !planner.timed_out => {
+            _ if self.best_capped && self.returns < self.max_returns && !timed_out => {
                 // The count below the best line was not reached from it, but the stage that found that
                 // line stopped at its cap still improving: the line is not yet its count's best. Go on
                 // at its count from it, then try the count below again.
-                returns += 1;
-                best_capped = false;
-                if let Some(line) = &best {
-                    n = line.len();
-                    controls = line.clone();
+                self.returns += 1;
+                self.best_capped = false;
+                // (A capped best is always a line: the two are set together.)
+                let line = self.best.clone().unwrap_or(c);
+                NextCount::Try {
+                    steps: line.len(),
+                    controls: line,
                 }
             }
             _ => {
                 // With a line in hand the count below it is unreachable from it, unless the stage was
                 // still improving when its continuations ran out.
-                if best.is_some() || grow_tries >= max_grow_tries || planner.timed_out {
-                    break capped || planner.timed_out;
+                if self.best.is_some() || self.grow_tries >= self.max_grow_tries || timed_out {
+                    return NextCount::Stop {
+                        short: capped || timed_out,
+                    };
                 }
                 // Not reachable at this count from this start: give it more steps.
-                grow_tries += 1;
-                n += (n / 20).max(2);
-                controls = c;
+                self.grow_tries += 1;
+                NextCount::Try {
+                    steps: n + (n / 20).max(2),
+                    controls: c,
+                }
             }
         }
-    };
-    Descended { line: best, short }
+    }
 }
 
 /// One count of a count search: the plan its stage ended with, whether the stage stopped at its
