@@ -183,13 +183,12 @@ pub(super) fn relaxed_plan(
     let mut fitted_any = false;
     let mut reached = true;
     while knot_frames > 1 {
-        let m = knot_frames as usize;
         let (knots_line, fitted) = knots_descent(
             planner,
             progress,
             &controls[..n.min(controls.len())],
             lo,
-            m,
+            knot_frames,
             relaxation,
             descent,
         );
@@ -198,7 +197,7 @@ pub(super) fn relaxed_plan(
         let Some(plan) = knots_line else { break };
         controls = plan
             .iter()
-            .flat_map(|u| std::iter::repeat_n(*u, m))
+            .flat_map(|u| std::iter::repeat_n(*u, knot_frames as usize))
             .collect();
         n = controls.len();
         knot_frames = finer_knot_frames(knot_frames);
@@ -239,11 +238,11 @@ fn knots_descent(
     progress: &mut dyn FnMut(Progress),
     controls: &[FrameControl],
     lo: usize,
-    frames_per_knot: usize,
+    frames_per_knot: u32,
     relaxation: Relaxation,
     descent: Descent,
 ) -> (Option<Vec<FrameControl>>, bool) {
-    let m = frames_per_knot;
+    let m = frames_per_knot as usize;
     // The chord of a knot leaves its frames' arc by at most the sagitta m^2 tau gamma1 / 8 (each frame
     // turns the heading by at most about gamma1 / V).
     let fl = planner.fl;
@@ -254,8 +253,7 @@ fn knots_descent(
     };
     let (knots, fitted) = coarse_start(planner, controls, m, over_knots);
     let count = knots.len();
-    let per = u32::try_from(m).unwrap_or(u32::MAX);
-    let search = descent.count_search(over_knots, per);
+    let search = descent.count_search(over_knots, frames_per_knot);
     let line = count_search(planner, progress, knots, count, lo / m, search).line;
     (line, fitted)
 }
