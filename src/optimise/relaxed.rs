@@ -179,9 +179,8 @@ pub(super) fn relaxed_plan(
     descent: Descent,
 ) -> Descended {
     let mut knot_frames = coarse_knot_frames(n, descent.coarse);
-    // Whether some knots' start was fitted to the run, and whether the last knots reached a line.
+    // Whether some knots' start was fitted to the run.
     let mut fitted_any = false;
-    let mut reached = true;
     while knot_frames > 1 {
         let (knots_line, fitted) = knots_descent(
             planner,
@@ -193,7 +192,6 @@ pub(super) fn relaxed_plan(
             descent,
         );
         fitted_any |= fitted;
-        reached = knots_line.is_some();
         let Some(plan) = knots_line else { break };
         controls = plan
             .iter()
@@ -202,9 +200,11 @@ pub(super) fn relaxed_plan(
         n = controls.len();
         knot_frames = finer_knot_frames(knot_frames);
     }
+    // The halving ends over knots only where a stage's knots reached no line.
+    let unreached = knot_frames > 1;
     if let Some(first) = descent
         .after_unclear_knots
-        .filter(|_| fitted_any || !reached)
+        .filter(|_| fitted_any || unreached)
     {
         let search = descent.count_search(first, 1);
         if let Some(line) = count_search(planner, progress, controls.clone(), n, lo, search).line {
@@ -1186,16 +1186,10 @@ mod tests {
     fn counts_and_crossings(
         search: impl FnOnce(&mut dyn FnMut(Progress)),
     ) -> Vec<(usize, Option<usize>)> {
-        let mut counts = Vec::new();
-        search(&mut |p| {
-            if let Progress::FrameCount {
-                frames, reached, ..
-            } = p
-            {
-                counts.push((frames, reached));
-            }
-        });
-        counts
+        stages_tried(search)
+            .into_iter()
+            .flat_map(|(_, counts)| counts)
+            .collect()
     }
 
     /// A stage of a descent as it reports it: its planning step (frames per knot) with the counts tried
