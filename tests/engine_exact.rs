@@ -73,3 +73,62 @@ fn a_million_frames_at_3500_ups_stay_finite_with_bounded_drift() {
     assert!(d.max_speed_drift < 0.01, "{d:?}");
     assert!(d.final_position_drift < 1e-3 * 3.5e6, "{d:?}");
 }
+
+/// A straight corridor 64 units wide with solid walls, its centre line at `y` units, from `x = 0` to
+/// past a finish line at `x = 3500`; entered at 600 ups along it.
+fn solid_corridor_at(y: f64) -> strafeopt::scene::Scene {
+    let text = format!(
+        r#"
+name = "solid-corridor"
+[engine]
+preset = "goldsrc"
+fps = 100
+airaccelerate = 10
+effects = ["air-accel", "max-velocity", "walls"]
+[start]
+position = [40.0, {y}]
+velocity = [600.0, 0.0]
+on-ground = false
+[finish]
+a = [3500.0, {lo}]
+b = [3500.0, {hi}]
+[[walls]]
+kind = "solid"
+points = [[3600.0, {hi}], [0.0, {hi}], [0.0, {lo}], [3600.0, {lo}]]
+"#,
+        lo = y - 32.0,
+        hi = y + 32.0,
+    );
+    strafeopt::scene::Scene::from_toml_str(&text, "test").unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn a_run_sliding_along_a_solid_wall_replays_in_the_games_arithmetic() {
+    // Turning left at maximum acceleration every frame, the run meets the left wall within a few frames
+    // and slides along it to the line, touching it every frame. The game's trace stops 1/32 unit short of
+    // the wall; stopped at clearance 0 instead, the f32 position rounds into the wall on some frame and
+    // the next trace starts inside it, where the hull is held for good and never reaches the line (at
+    // `y = 2500.3`, where the wall's line is no `f32` number).
+    use strafeopt::sim::{SideStrafer, Simulation};
+    for y in [1000.3, 1777.7, 2500.3] {
+        let scene = solid_corridor_at(y);
+        let sim = Simulation::new(&scene).unwrap_or_else(|e| panic!("{e}"));
+        let plan = sim.run(&mut SideStrafer { side: Side::Left });
+        assert!(
+            plan.feasible() && plan.collisions() > 100,
+            "{y}: the plan slides"
+        );
+        let game = sim.run_engine_exact(&plan.controls);
+        let (planned, played) = (plan.crossing, game.crossing);
+        let (Some(planned), Some(played)) = (planned, played) else {
+            panic!("{y}: the game's run does not reach the line: {game:?}");
+        };
+        assert!(game.feasible(), "{y}: {game:?}");
+        // Off the wall by the stand-off alone: the two runs slide the same way.
+        assert!((game.min_clearance - 0.03125).abs() < 1e-3, "{y}: {game:?}");
+        assert!(
+            planned.frames.abs_diff(played.frames) <= 1,
+            "{y}: {planned:?} {played:?}"
+        );
+    }
+}

@@ -3,7 +3,7 @@
 
 use strafeopt::geometry::{
     BoundaryKind, Cast, Corridor, FinishLine, FinishPoint, SweepStatus, Wall, CONTACT_TOL_UNITS,
-    HULL_HALF_WIDTH_UNITS,
+    DIST_EPSILON_UNITS, HULL_HALF_WIDTH_UNITS,
 };
 use strafeopt::physics::Vec2;
 
@@ -305,6 +305,34 @@ fn sweep_slides_along_walls_and_stops_in_corners() {
     let r = corridor.sweep(v(50.0, 10.0), v(100.0, 0.0), tau);
     assert!(matches!(r.status, SweepStatus::StartedInside { .. }));
     assert_eq!((r.pos, r.vel), (v(50.0, 10.0), Vec2::ZERO));
+}
+
+#[test]
+fn the_games_sweep_stops_a_32nd_of_a_unit_short_of_the_wall() {
+    let corridor = Corridor::new(&room(BoundaryKind::Solid)).unwrap();
+    let tau = 0.01;
+    let stand_off = DIST_EPSILON_UNITS;
+    // Diagonally into the floor, 20 units into its plane over the frame: the hit comes
+    // `stand_off / 20` of the move early, and the slide uses the time left, so x ends where it would
+    // without the stand-off.
+    let r = corridor.sweep_standing_off(v(50.0, 26.0), v(1000.0, -2000.0), tau, stand_off);
+    assert_eq!(r.status, SweepStatus::Clipped { contacts: 1 });
+    assert!((r.pos.y - (H + stand_off)).abs() < 1e-12, "{:?}", r.pos);
+    assert!((r.pos.x - 60.0).abs() < 1e-9, "{:?}", r.pos);
+    assert_eq!(r.vel, v(1000.0, 0.0));
+    // Starting within the stand-off and moving in: not moved into the wall, the velocity clipped and
+    // the slide taking the whole frame.
+    let r = corridor.sweep_standing_off(v(50.0, H + 0.01), v(1000.0, -500.0), tau, stand_off);
+    assert_eq!(r.status, SweepStatus::Clipped { contacts: 1 });
+    assert_eq!(r.pos, v(60.0, H + 0.01));
+    // Into the concave corner at (0, 0): held a 32nd off both walls.
+    let r = corridor.sweep_standing_off(v(20.0, 20.0), v(-1000.0, -1000.0), tau, stand_off);
+    assert_eq!(r.vel, Vec2::ZERO);
+    assert!(
+        (r.pos - v(H + stand_off, H + stand_off)).length() < 1e-9,
+        "{:?}",
+        r.pos
+    );
 }
 
 #[test]

@@ -41,6 +41,11 @@ pub const HULL_HALF_WIDTH_UNITS: f64 = 16.0;
 /// stops a move only when the hull would go deeper than this.
 pub const CONTACT_TOL_UNITS: f64 = 1e-9;
 
+/// How far short of a wall the game's hull trace stops, units: `DIST_EPSILON`, 1/32 (GoldSrc's and
+/// Source's hull checks, "to keep floating point happy"). The engine-exact mode stands off this far
+/// ([`Corridor::sweep_standing_off`]); planning in `f64` stops where the hull touches.
+pub const DIST_EPSILON_UNITS: f64 = 0.03125;
+
 /// Shortest wall segment accepted, units; shorter segments have no direction.
 pub const MIN_SEGMENT_LENGTH_UNITS: f64 = 1e-9;
 

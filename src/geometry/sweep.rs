@@ -154,8 +154,25 @@ impl Corridor {
     /// 3. if no trace moved the hull at all, zero the velocity.
     ///
     /// Deliberate simplifications of the game: no `DIST_EPSILON` back-off from the wall (we stop at
-    /// clearance 0 exactly) and no `STOP_EPSILON` zeroing of velocity components under 0.1 ups.
+    /// clearance 0 exactly; the engine-exact mode backs off, [`Corridor::sweep_standing_off`]) and no
+    /// `STOP_EPSILON` zeroing of velocity components under 0.1 ups.
     pub fn sweep(&self, pos: Vec2, vel_ups: Vec2, frame_time_s: f64) -> SweepResult {
+        self.sweep_standing_off(pos, vel_ups, frame_time_s, 0.0)
+    }
+
+    /// [`Corridor::sweep`] with each hit stopped `stand_off_units` short of the wall's plane, measured
+    /// along its normal, as the game's trace stops [`super::DIST_EPSILON_UNITS`] short: the fraction of
+    /// a move that starts `d1` off the plane and would end `d2` off it is `(d1 - stand_off) / (d1 - d2)`,
+    /// at least 0. Positions kept in `f32` need it: a hull stopped at clearance 0 and rounded to `f32`
+    /// lands inside the wall about half the time, where the next trace starts solid and the hull is held
+    /// there for good.
+    pub fn sweep_standing_off(
+        &self,
+        pos: Vec2,
+        vel_ups: Vec2,
+        frame_time_s: f64,
+        stand_off_units: f64,
+    ) -> SweepResult {
         let mut pos = pos;
         let mut vel = vel_ups;
         let mut time_left = frame_time_s;
@@ -182,11 +199,18 @@ impl Corridor {
                     break;
                 }
                 Cast::Hit(c) => {
-                    if c.fraction > 0.0 {
-                        pos += delta * c.fraction;
+                    // `d1 - d2`: how far the whole move goes into the wall's plane.
+                    let into_plane = -delta.dot(c.normal);
+                    let fraction = if into_plane > 0.0 {
+                        (c.fraction - stand_off_units / into_plane).max(0.0)
+                    } else {
+                        c.fraction
+                    };
+                    if fraction > 0.0 {
+                        pos += delta * fraction;
                         moved = true;
                     }
-                    time_left -= time_left * c.fraction;
+                    time_left -= time_left * fraction;
                     contacts += 1;
                     vel = vel - c.normal * vel.dot(c.normal);
                     if bump + 1 == MAX_BUMPS_PER_FRAME && vel != Vec2::ZERO && time_left > 0.0 {

@@ -12,7 +12,7 @@ pub mod trace;
 
 use crate::budget::{Budget, FRAMES_PER_BUDGET_CHECK};
 use crate::error::Result;
-use crate::geometry::{BoundaryKind, Corridor};
+use crate::geometry::{BoundaryKind, Corridor, DIST_EPSILON_UNITS};
 use crate::physics::{Control, Effect, PlayerState, Stepper, Vec2, Wish};
 use crate::scene::Scene;
 pub use controllers::{Greedy, Playback, SideStrafer};
@@ -111,7 +111,8 @@ impl<'s> Simulation<'s> {
     }
 
     /// Plays `controls` in the engine-exact mode (f32 state, anglemod yaw; docs/physics.md section 1) through the
-    /// same walls, rule lines and finish line. The walls are queried in f64 on the f32 positions.
+    /// same walls, rule lines and finish line. The walls are queried in f64 on the f32 positions, and a
+    /// hit stops [`DIST_EPSILON_UNITS`] short of the wall, as the game's trace does.
     pub fn run_engine_exact(&self, controls: &[Control]) -> EngineRun {
         self.run_engine_exact_within(controls, &Budget::unlimited())
     }
@@ -139,7 +140,9 @@ impl<'s> Simulation<'s> {
             game.pre_move(&mut g, &engine_wish(c));
             if self.solid_walls {
                 let s = from_engine_state(&g);
-                let r = self.corridor.sweep(s.pos, s.vel, tau);
+                let r = self
+                    .corridor
+                    .sweep_standing_off(s.pos, s.vel, tau, DIST_EPSILON_UNITS);
                 g.pos = crate::physics::V2::from_f64(r.pos);
                 g.vel = crate::physics::V2::from_f64(r.vel);
             } else {
