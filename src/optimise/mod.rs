@@ -2,6 +2,7 @@
 //! the minimal-time search ([`model`]), and the planners of scenes beyond air strafing: the Source jump
 //! boost ([`jumps`]) and ground frames, jumps and the bunnyhop cap ([`hops`]).
 
+mod after_contact;
 mod airborne;
 mod anchored;
 mod baseline;

@@ -16,6 +16,7 @@
 //!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
+use super::after_contact::planned_on_after_wall_contacts;
 use super::airborne::{plan_airborne, plan_polished_finely, AirbornePlan};
 use super::baseline::{baseline, corner_caps, given_up_frame, GreedyGuide, GuideRun};
 use super::bound::{frame_limited_scene, lower_bound_within};
@@ -317,11 +318,14 @@ pub struct StageSeconds {
     pub jumps: f64,
     /// The plan replayed in the engine-exact mode, and the certificate's estimates.
     pub verification: f64,
+    /// A greedy answer sliding along a wall, planned on from after its last contact: the rest's solves
+    /// and the plans played whole.
+    pub after_contact: f64,
 }
 
 impl StageSeconds {
     /// Each stage's name, as the text output prints it, and its seconds, in the order the stages run.
-    pub fn named(&self) -> [(&'static str, f64); 11] {
+    pub fn named(&self) -> [(&'static str, f64); 12] {
         [
             ("bound", self.bound),
             ("baseline", self.baseline),
@@ -334,6 +338,7 @@ impl StageSeconds {
             ("fine polish", self.fine_polish),
             ("jumps", self.jumps),
             ("verification", self.verification),
+            ("after a wall contact", self.after_contact),
         ]
     }
 
@@ -367,7 +372,8 @@ pub struct Outcome {
     pub stats: SearchStats,
     /// Wall-clock time of the solve, seconds.
     pub solve_seconds: f64,
-    /// The plan's source: `greedy` or `optimised`.
+    /// The plan's source: `greedy`, `optimised`, or the greedy run to a wall contact and then optimised
+    /// ([`super::after_contact`]).
     pub source: &'static str,
     /// The guide and settings of the greedy strafer that gave the baseline.
     pub greedy_guide: GreedyGuide,
@@ -563,8 +569,41 @@ impl Finisher<'_> {
 }
 
 /// The solve of every entry point, at `settings` within `budget` (see [`solve_with_progress`]): the
-/// stages of the module documentation in order.
+/// stages of the module documentation in order, then on airborne scenes with solid walls, where the
+/// answer is a greedy run sliding along a wall, that run planned on from after its last contact
+/// ([`super::after_contact`]).
 fn solve_within(
+    scene: &Scene,
+    settings: &SearchSettings,
+    budget: Budget,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Outcome> {
+    let started = Instant::now();
+    let outcome = solve_stages(scene, settings, budget, progress)?;
+    if !scene.effects.is_air_only() {
+        return Ok(outcome);
+    }
+    let after_contact_started = Instant::now();
+    let mut solve_rest = |rest: &Scene| solve_stages(rest, settings, budget, &mut |_| {});
+    let outcome = planned_on_after_wall_contacts(
+        scene,
+        settings.margin_units,
+        outcome,
+        &budget,
+        &mut solve_rest,
+    );
+    Ok(Outcome {
+        solve_seconds: seconds_since(started),
+        stage_seconds: StageSeconds {
+            after_contact: seconds_since(after_contact_started),
+            ..outcome.stage_seconds
+        },
+        ..outcome
+    })
+}
+
+/// The stages of the module documentation in order, on `scene` at `settings` within `budget`.
+fn solve_stages(
     scene: &Scene,
     settings: &SearchSettings,
     budget: Budget,
