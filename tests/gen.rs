@@ -687,14 +687,16 @@ fn bench_generated_gives_a_record_per_scene_and_the_distributions() {
             "{r}"
         );
     }
-    let (in_frame, behind, past) = (
+    let (in_frame, behind, ahead, past) = (
         v["in_relaxed_frame"].as_u64().unwrap_or(99),
         v["behind_relaxed_frame"].as_u64().unwrap_or(99),
+        v["ahead_of_relaxed_frame"].as_u64().unwrap_or(99),
         v["behind_where_estimates_pass_the_frame"]
             .as_u64()
             .unwrap_or(99),
     );
-    assert!(in_frame + behind <= 2 && past <= behind, "{v}");
+    // Both plans have a certificate: each is in its frame, behind it or ahead of it.
+    assert!(in_frame + behind + ahead == 2 && past <= behind, "{v}");
     let gap = &v["distributions"][1];
     assert_eq!(gap["count"], 2);
     assert!(gap["min"].as_f64() <= gap["median"].as_f64());

@@ -57,6 +57,9 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     let in_frame = share(&records, |r| r.frames_behind_relaxed() == Some(0));
     let is_behind = |r: &SceneRecord| r.frames_behind_relaxed().is_some_and(|k| k > 0);
     let behind = share(&records, is_behind);
+    let ahead = share(&records, |r| {
+        r.frames_behind_relaxed().is_some_and(|k| k < 0)
+    });
     let behind_past_estimates = share(&records, |r| {
         is_behind(r) && r.estimates_pass_the_relaxed_frame() == Some(true)
     });
@@ -74,6 +77,7 @@ pub fn run(args: &BenchArgs) -> Result<String> {
             "in_relaxed_frame": in_frame.0,
             "behind_relaxed_frame": behind.0,
             "behind_where_estimates_pass_the_frame": behind_past_estimates.0,
+            "ahead_of_relaxed_frame": ahead.0,
             "scenes": records,
         });
         return serde_json::to_string(&value)
@@ -97,10 +101,12 @@ pub fn run(args: &BenchArgs) -> Result<String> {
     ));
     out.push_str(&format!(
         "plan in its relaxed optimum's frame: {}; a frame or more behind it: {}, on {} of them the \
-         estimated zigzag and guard alone take more than that frame leaves\n",
+         estimated zigzag and guard alone take more than that frame leaves; ahead of it: {} (a plan \
+         sliding along a wall, or another local optimum)\n",
         pct(in_frame),
         behind.0,
-        behind_past_estimates.0
+        behind_past_estimates.0,
+        ahead.0
     ));
     Ok(out)
 }
