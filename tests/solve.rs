@@ -643,8 +643,17 @@ fn a_greedy_run_sliding_along_a_wall_ahead_of_every_plan_is_planned_on_from_its_
     let scene = generate(1313, 13, &GeneratorSettings::ci_sized())
         .unwrap_or_else(|e| panic!("{e}"))
         .scene;
-    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
-        .unwrap_or_else(|e| panic!("{e}"));
+    let mut kept = Vec::new();
+    let o = solve_with_progress(
+        &scene,
+        &SearchSettings::for_quality(Quality::Fast),
+        &mut |p| {
+            if let Progress::AfterWallContact { kept_frames } = p {
+                kept.push(kept_frames);
+            }
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
         o.source, "greedy to a wall contact, then optimised",
         "{:?}",
@@ -673,6 +682,12 @@ fn a_greedy_run_sliding_along_a_wall_ahead_of_every_plan_is_planned_on_from_its_
         .unwrap_or_else(|| panic!("the greedy run touches no wall"));
     let through = usize::try_from(touched).unwrap_or(usize::MAX);
     assert_eq!(o.controls[..through], o.greedy.controls[..through]);
+    // The rests solved were reported, each after frames of the greedy run through a contact.
+    let greedy_frames = usize::try_from(greedy.frames).unwrap_or(0);
+    assert!(
+        !kept.is_empty() && kept.iter().all(|&k| k >= through && k < greedy_frames),
+        "{kept:?}"
+    );
     assert!(
         o.trace.min_clearance() < 1e-6,
         "{}",

@@ -56,6 +56,10 @@ pub fn run(args: &SolveArgs) -> Result<String> {
             bar.set_prefix(Stage::Rounding.name());
             bar.set_message(p.to_string());
         }
+        Progress::AfterWallContact { .. } => {
+            bar.set_prefix(Stage::Relaxed.name());
+            bar.set_message(p.to_string());
+        }
     });
     bar.finish_and_clear();
     let mut outcome = outcome?;

@@ -77,14 +77,14 @@ pub(super) fn scene_after(scene: &Scene, run: &Trace, frames: usize) -> Scene {
 /// `outcome`, the solve of the airborne `scene`, planned on from after its greedy run's wall contacts
 /// where it is that greedy run (see the module documentation): after the last contact, then after the
 /// first and each rest's own first in turn. `solve_rest` solves a rest's scene with the solve's own
-/// stages; the planning margin of `scene`'s law at `final_margin_units` is how far off the walls a rest
+/// stages, told how many frames of the whole scene's start are kept before it; the planning margin of `scene`'s law at `final_margin_units` is how far off the walls a rest
 /// starts. Stops when `budget` runs out.
 pub(super) fn planned_on_after_wall_contacts(
     scene: &Scene,
     final_margin_units: f64,
     outcome: Outcome,
     budget: &Budget,
-    solve_rest: &mut dyn FnMut(&Scene) -> Result<Outcome>,
+    solve_rest: &mut dyn FnMut(&Scene, usize) -> Result<Outcome>,
 ) -> Outcome {
     if outcome.source != "greedy" || !outcome.trace.feasible() {
         return outcome;
@@ -140,7 +140,7 @@ struct PlanningOn<'a, 's> {
     sim: &'a Simulation<'s>,
     margin_units: f64,
     budget: &'a Budget<'a>,
-    solve_rest: &'a mut dyn FnMut(&Scene) -> Result<Outcome>,
+    solve_rest: &'a mut dyn FnMut(&Scene, usize) -> Result<Outcome>,
     best: Outcome,
     stats: SearchStats,
 }
@@ -160,7 +160,7 @@ impl PlanningOn<'_, '_> {
         if self.budget.expired() {
             return None;
         }
-        let rest = (self.solve_rest)(&scene_after(scene, run, kept)).ok()?;
+        let rest = (self.solve_rest)(&scene_after(scene, run, kept), played.len() + kept).ok()?;
         self.stats.add(&rest.stats);
         let controls: Vec<Control> = played
             .iter()

@@ -410,6 +410,12 @@ pub enum Progress {
         /// The wall margin, units.
         margin_units: f64,
     },
+    /// Solving the rest of a greedy run that slides along a wall, after its first `kept_frames` frames
+    /// as played ([`super::after_contact`]).
+    AfterWallContact {
+        /// The frames of the greedy run kept, from the scene's start.
+        kept_frames: usize,
+    },
 }
 
 impl Progress {
@@ -466,6 +472,12 @@ impl std::fmt::Display for Progress {
                 write!(
                     f,
                     "polishing the plan on at a wall margin of {margin_units} units"
+                )
+            }
+            Progress::AfterWallContact { kept_frames } => {
+                write!(
+                    f,
+                    "the greedy run slides along a wall: planning on after its frame {kept_frames}"
                 )
             }
         }
@@ -584,7 +596,10 @@ fn solve_within(
         return Ok(outcome);
     }
     let after_contact_started = Instant::now();
-    let mut solve_rest = |rest: &Scene| solve_stages(rest, settings, budget, &mut |_| {});
+    let mut solve_rest = |rest: &Scene, kept_frames: usize| {
+        progress(Progress::AfterWallContact { kept_frames });
+        solve_stages(rest, settings, budget, &mut |_| {})
+    };
     let outcome = planned_on_after_wall_contacts(
         scene,
         settings.margin_units,
@@ -833,6 +848,7 @@ mod tests {
             Progress::Polishing {
                 margin_units: 0.002,
             },
+            Progress::AfterWallContact { kept_frames: 57 },
         ]
         .map(|p| p.to_string());
         assert_eq!(
@@ -845,6 +861,7 @@ mod tests {
                 "trying 2358 frames over knots of 3: crosses in frame 2358",
                 "rounding sides, polishing, checking in engine-exact mode",
                 "polishing the plan on at a wall margin of 0.002 units",
+                "the greedy run slides along a wall: planning on after its frame 57",
             ]
         );
     }
