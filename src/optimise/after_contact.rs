@@ -1,14 +1,16 @@
-//! A greedy run that slides along a solid wall, planned on from after its last contact.
+//! A greedy run that slides along a solid wall, planned on from after its wall contacts.
 //!
 //! The planning model has no collisions, so the relaxed problem holds only runs clear of the walls. On
 //! solid walls a run that slides along one can be ahead of all of them: a wall takes the speed across it
 //! off at once, where braking takes a corner's length; and a fast start before a sharp corner of a narrow
-//! corridor may have no line clear of the walls at all. The solve then returns the greedy run as it was
-//! played. Here that run is kept as played up to where it is clear of the walls again after its last
+//! corridor may have no line clear of the walls at all. The solve's answer is then the greedy run as it
+//! was played. Here that run is kept as played up to where it is clear of the walls again after a
 //! contact, and the rest is solved as a scene of its own, from the run's state there, by the whole
 //! solve's stages. The two played one after the other are the plan where they are valid in `f64` and
-//! engine-exact and cross sooner. Where the rest's answer is again its own greedy run sliding along a
-//! wall, it is planned on from its last contact in turn, at most [`MAX_CONTACT_RESTARTS`] times.
+//! engine-exact and cross sooner. The rest is planned on from after the run's last contact (its own rest
+//! clear of the walls, a start), then from after its first; where that rest's answer is again its own
+//! greedy run sliding along a wall, from after that run's first contact in turn, at most
+//! [`MAX_CONTACT_RESTARTS`] times.
 
 use super::model::FrameLaw;
 use super::search::{Outcome, SearchStats, SearchStatus};
@@ -19,8 +21,9 @@ use crate::physics::{Control, PlayerState};
 use crate::scene::Scene;
 use crate::sim::{Playback, Simulation, Trace};
 
-/// Most times a solve plans on from a wall contact: each from the last contact of the run the rest
-/// before it returned. A bound on the work.
+/// Most times a solve plans on from a first wall contact: the greedy run's, then each from the first
+/// contact of the run the rest before it returned. A bound on the work: on `gen-2323-0` (docs/design.md),
+/// whose rests slide again at every corner, eight took 73 s and found nothing three had not.
 pub(super) const MAX_CONTACT_RESTARTS: usize = 3;
 
 /// The plan's source when it was planned on from a greedy run's wall contact.
@@ -75,10 +78,10 @@ pub(super) fn scene_after(scene: &Scene, run: &Trace, frames: usize) -> Scene {
 }
 
 /// `outcome`, the solve of the airborne `scene`, planned on from after its greedy run's wall contacts
-/// where it is that greedy run (see the module documentation): after the last contact, then after the
-/// first and each rest's own first in turn. `solve_rest` solves a rest's scene with the solve's own
-/// stages, told how many frames of the whole scene's start are kept before it; the planning margin of `scene`'s law at `final_margin_units` is how far off the walls a rest
-/// starts. Stops when `budget` runs out.
+/// where it is that greedy run (see the module documentation). `solve_rest` solves a rest's scene with
+/// the solve's own stages, told how many frames from the whole scene's start are kept before it. A rest
+/// starts the planning margin of `scene`'s law at `final_margin_units` off the walls. Stops when `budget`
+/// runs out.
 pub(super) fn planned_on_after_wall_contacts(
     scene: &Scene,
     final_margin_units: f64,
@@ -101,32 +104,12 @@ pub(super) fn planned_on_after_wall_contacts(
         best: outcome,
         stats: SearchStats::default(),
     };
-    let margin = planning_on.margin_units;
-    let last = frames_kept_before_planning_on(&greedy, margin, After::LastContact);
+    let last =
+        frames_kept_before_planning_on(&greedy, planning_on.margin_units, After::LastContact);
     if let Some(kept) = last {
         planning_on.rest_planned(scene, &[], &greedy, kept);
     }
-    let mut played: Vec<Control> = Vec::new();
-    let mut rest_scene = scene.clone();
-    let mut run = greedy;
-    for _ in 0..MAX_CONTACT_RESTARTS {
-        let Some(kept) = frames_kept_before_planning_on(&run, margin, After::FirstContact) else {
-            break;
-        };
-        // After a single contact the first is the last, planned on from already.
-        if played.is_empty() && last == Some(kept) {
-            break;
-        }
-        let Some(rest) = planning_on.rest_planned(&rest_scene, &played, &run, kept) else {
-            break;
-        };
-        played.extend_from_slice(&run.controls[..kept]);
-        rest_scene = scene_after(&rest_scene, &run, kept);
-        if rest.source != "greedy" {
-            break;
-        }
-        run = rest.trace;
-    }
+    planning_on.planned_on_from_each_first_contact(scene, greedy, last);
     let PlanningOn {
         mut best, stats, ..
     } = planning_on;
@@ -146,6 +129,40 @@ struct PlanningOn<'a, 's> {
 }
 
 impl PlanningOn<'_, '_> {
+    /// `greedy`, the answer of `scene`, planned on from after its first contact, then each rest's
+    /// greedy answer from after its own first contact in turn, at most [`MAX_CONTACT_RESTARTS`] times.
+    /// `planned_from_the_last` is the frames kept where the rest after its last contact was solved.
+    fn planned_on_from_each_first_contact(
+        &mut self,
+        scene: &Scene,
+        greedy: Trace,
+        planned_from_the_last: Option<usize>,
+    ) {
+        let mut played: Vec<Control> = Vec::new();
+        let mut rest_scene = scene.clone();
+        let mut run = greedy;
+        for _ in 0..MAX_CONTACT_RESTARTS {
+            let Some(kept) =
+                frames_kept_before_planning_on(&run, self.margin_units, After::FirstContact)
+            else {
+                break;
+            };
+            // After a single contact the first is the last, planned on from already.
+            if played.is_empty() && planned_from_the_last == Some(kept) {
+                break;
+            }
+            let Some(rest) = self.rest_planned(&rest_scene, &played, &run, kept) else {
+                break;
+            };
+            played.extend_from_slice(&run.controls[..kept]);
+            rest_scene = scene_after(&rest_scene, &run, kept);
+            if rest.source != "greedy" {
+                break;
+            }
+            run = rest.trace;
+        }
+    }
+
     /// `run`, played from the start of `scene` after the frames of `played` (from the start of the whole
     /// scene), kept for its first `kept` frames and the rest solved from there; the whole kept as the
     /// best where it is faster. The rest's outcome; `None` where the rest's solve failed or the budget
