@@ -22,8 +22,8 @@ use crate::scene::Scene;
 use crate::sim::{Playback, Simulation, Trace};
 
 /// Most times a solve plans on from a first wall contact: the greedy run's, then each from the first
-/// contact of the run the rest before it returned. A bound on the work: on `gen-2323-0` (docs/design.md),
-/// whose rests slide again at every corner, eight took 73 s and found nothing three had not.
+/// contact of the run the rest before it returned. A bound on the work, where the rests slide again at
+/// every corner (docs/design.md, "A greedy answer planned on from its wall contacts").
 pub(super) const MAX_CONTACT_RESTARTS: usize = 3;
 
 /// The plan's source when it was planned on from a greedy run's wall contact.
