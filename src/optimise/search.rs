@@ -14,6 +14,10 @@
 //!    ([`super::airborne::plan_polished_finely`]): half the final margin, and at `exact` then the
 //!    certificate's.
 //!
+//! 6. Where the answer of an airborne scene is then a greedy run sliding along a solid wall (ahead of every
+//!    plan clear of the walls, which is all the planning model holds), that run kept as played through
+//!    a wall contact and the rest solved by stages 1 to 5 from there ([`super::after_contact`]).
+//!
 //! Jumping scenes go to the jump planner ([`super::jumps`]) after stage 1.
 
 use super::after_contact::planned_on_after_wall_contacts;
@@ -318,7 +322,7 @@ pub struct StageSeconds {
     pub jumps: f64,
     /// The plan replayed in the engine-exact mode, and the certificate's estimates.
     pub verification: f64,
-    /// A greedy answer sliding along a wall, planned on from after its last contact: the rest's solves
+    /// A greedy answer sliding along a wall, planned on from after its wall contacts: the rests' solves
     /// and the plans played whole.
     pub after_contact: f64,
 }
@@ -581,8 +585,8 @@ impl Finisher<'_> {
 }
 
 /// The solve of every entry point, at `settings` within `budget` (see [`solve_with_progress`]): the
-/// stages of the module documentation in order, then on airborne scenes with solid walls, where the
-/// answer is a greedy run sliding along a wall, that run planned on from after its last contact
+/// stages of the module documentation in order, then on airborne scenes, where the answer is a greedy
+/// run sliding along a solid wall, that run planned on from after its wall contacts
 /// ([`super::after_contact`]).
 fn solve_within(
     scene: &Scene,
