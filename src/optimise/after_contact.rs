@@ -247,27 +247,13 @@ mod tests {
     /// the given clearance after each frame.
     fn run_with(clearances: &[f64], contacts: &[u64]) -> Trace {
         let mut t = Trace::new("test".into(), &PlayerState::default(), 10.0);
-        let start = FrameRecord {
-            frame: 0,
-            time: 0.0,
-            pos: Vec2::ZERO,
-            vel: Vec2::new(300.0, 0.0),
-            speed: 300.0,
-            yaw_rad: 0.0,
-            theta_rad: 0.0,
-            on_ground: false,
-            ducked: false,
-            clearance: 10.0,
-            contacts: 0,
-            broke_rule: false,
-        };
         for (i, &clearance) in clearances.iter().enumerate() {
             let frame = i as u64 + 1;
             let record = FrameRecord {
                 frame,
                 clearance,
                 contacts: u32::from(contacts.contains(&frame)),
-                ..t.frames.last().copied().unwrap_or(start)
+                ..t.frames.last().copied().unwrap_or(t.start)
             };
             t.push(
                 record,
