@@ -634,6 +634,31 @@ fn a_seed_that_never_reaches_the_line_is_planned_over_twice_the_bounds_frames_no
 }
 
 #[test]
+fn a_greedy_run_no_plan_beats_is_returned_and_said_so() {
+    // Generated scene 5 of seed 6363 (`strafeopt gen --seed 6363 --fps 250`: one 31-degree turn, 163
+    // units wide between rule lines, in at 1500 ups): the greedy run keeps 24 units off the walls and
+    // crosses in its relaxed optimum's frame, 0.015 ms after it; every plan replays valid but later.
+    // The greedy run is returned, touching no wall so not planned on, and the status says why, not
+    // that no plan stayed valid.
+    let family = GeneratorSettings {
+        fps: vec![250],
+        ..GeneratorSettings::default()
+    };
+    let scene = generate(6363, 5, &family)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .scene;
+    let o = solve(&scene, &SearchSettings::for_quality(Quality::Fast))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(o.source, "greedy", "{:?}", o.status);
+    assert_eq!(o.greedy.first_contact(), None);
+    assert!(o.stats.valid_replays > 0, "{:?}", o.stats);
+    let SearchStatus::NoImprovement { reason } = &o.status else {
+        panic!("{:?}", o.status)
+    };
+    assert!(reason.contains("slower than the greedy run"), "{reason}");
+}
+
+#[test]
 fn a_greedy_run_sliding_along_a_wall_ahead_of_every_plan_is_planned_on_from_its_contact() {
     // Generated scene 13 of seed 1313 (CI-sized family: 100 fps, air acceleration 10, two left turns, 96
     // units wide, solid walls, in at 1,346 ups): the greedy run slides along a wall and crosses in frame

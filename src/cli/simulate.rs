@@ -106,9 +106,7 @@ pub fn summary_json(
     let frames = trace
         .crossing
         .map_or(trace.frames.len() as u64, |c| c.frames);
-    let gap = trace
-        .crossing
-        .map(|c| (c.time - bound.crossing.time) / bound.crossing.time.max(f64::MIN_POSITIVE));
+    let gap = trace.crossing.map(|c| bound.gap(c.time));
     json!({
         "scenario": scene.name,
         "scene_path": scene_path(scene),
@@ -188,7 +186,7 @@ fn summary_text(
     if let Some(c) = trace.crossing {
         out.push_str(&format!(
             "gap to bound:   {:.3}%\n",
-            100.0 * (c.time - bound.crossing.time) / bound.crossing.time.max(f64::MIN_POSITIVE)
+            100.0 * bound.gap(c.time)
         ));
     }
     out

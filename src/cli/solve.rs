@@ -158,7 +158,7 @@ pub fn summary_json(scene: &Scene, quality: Quality, o: &Outcome) -> Value {
             "time": lb.time,
             "path_length": o.bound.path_length,
         },
-        "gap_to_lower_bound": crossing.map(|c| (c.time - lb.time) / lb.time.max(f64::MIN_POSITIVE)),
+        "gap_to_lower_bound": crossing.map(|c| o.bound.gap(c.time)),
         "status": o.status,
         "stats": o.stats,
         "stage_seconds": o.stage_seconds,
@@ -353,14 +353,10 @@ fn certificate_text(scene: &Scene, o: &Outcome) -> String {
 /// greedy run.
 fn gains_text(o: &Outcome) -> String {
     let mut s = String::new();
-    let lb = o.bound.crossing;
     if let Some(c) = o.trace.crossing {
         s.push_str(&field(
             "gap to bound",
-            format!(
-                "{:>10.3} %",
-                100.0 * (c.time - lb.time) / lb.time.max(f64::MIN_POSITIVE)
-            ),
+            format!("{:>10.3} %", 100.0 * o.bound.gap(c.time)),
         ));
         if let Some(g) = o.greedy.crossing.filter(|_| o.greedy.feasible()) {
             s.push_str(&field(

@@ -89,7 +89,8 @@ pub(super) fn planned_on_after_wall_contacts(
     budget: &Budget,
     solve_rest: &mut dyn FnMut(&Scene, usize) -> Result<Outcome>,
 ) -> Outcome {
-    if outcome.source != "greedy" || !outcome.trace.feasible() {
+    let sliding = outcome.trace.first_contact().is_some();
+    if outcome.source != "greedy" || !outcome.trace.feasible() || !sliding {
         return outcome;
     }
     let Ok(sim) = Simulation::new(scene) else {
@@ -107,7 +108,7 @@ pub(super) fn planned_on_after_wall_contacts(
     let last =
         frames_kept_before_planning_on(&greedy, planning_on.margin_units, After::LastContact);
     if let Some(kept) = last {
-        planning_on.rest_planned(scene, &[], &greedy, kept);
+        planning_on.rest_planned(&scene_after(scene, &greedy, kept), &greedy.controls[..kept]);
     }
     planning_on.planned_on_from_each_first_contact(scene, greedy, last);
     let PlanningOn {
@@ -151,11 +152,11 @@ impl PlanningOn<'_, '_> {
             if played.is_empty() && planned_from_the_last == Some(kept) {
                 break;
             }
-            let Some(rest) = self.rest_planned(&rest_scene, &played, &run, kept) else {
-                break;
-            };
             played.extend_from_slice(&run.controls[..kept]);
             rest_scene = scene_after(&rest_scene, &run, kept);
+            let Some(rest) = self.rest_planned(&rest_scene, &played) else {
+                break;
+            };
             if rest.source != "greedy" {
                 break;
             }
@@ -163,28 +164,16 @@ impl PlanningOn<'_, '_> {
         }
     }
 
-    /// `run`, played from the start of `scene` after the frames of `played` (from the start of the whole
-    /// scene), kept for its first `kept` frames and the rest solved from there; the whole kept as the
-    /// best where it is faster. The rest's outcome; `None` where the rest's solve failed or the budget
-    /// ran out.
-    fn rest_planned(
-        &mut self,
-        scene: &Scene,
-        played: &[Control],
-        run: &Trace,
-        kept: usize,
-    ) -> Option<Outcome> {
+    /// The rest `rest_scene`, which starts where the controls `played` (from the whole scene's start)
+    /// leave the player, solved; the two together kept as the best where they are faster. The rest's
+    /// outcome; `None` where its solve failed or the budget ran out.
+    fn rest_planned(&mut self, rest_scene: &Scene, played: &[Control]) -> Option<Outcome> {
         if self.budget.expired() {
             return None;
         }
-        let rest = (self.solve_rest)(&scene_after(scene, run, kept), played.len() + kept).ok()?;
+        let rest = (self.solve_rest)(rest_scene, played.len()).ok()?;
         self.stats.add(&rest.stats);
-        let controls: Vec<Control> = played
-            .iter()
-            .chain(&run.controls[..kept])
-            .chain(&rest.controls)
-            .copied()
-            .collect();
+        let controls: Vec<Control> = played.iter().chain(&rest.controls).copied().collect();
         if let Some(spliced) =
             spliced_if_faster(self.sim, &self.best, controls, &rest.status, self.budget)
         {
@@ -219,11 +208,10 @@ fn spliced_if_faster(
     if !engine_exact.feasible() {
         return None;
     }
-    let bound_s = best.bound.crossing.time;
     let status = match rest_status.stopped_in() {
         Some(_) => rest_status.clone(),
         None => SearchStatus::Converged {
-            gap: (t - bound_s) / bound_s.max(f64::MIN_POSITIVE),
+            gap: best.bound.gap(t),
         },
     };
     // The controls as played: a playback repeats its last control past its end.

@@ -631,6 +631,13 @@ pub struct LowerBound {
     pub crossing: Crossing,
 }
 
+impl LowerBound {
+    /// The relative gap of a run crossing at `time_s` seconds to the bound: `(time - bound) / bound`.
+    pub fn gap(&self, time_s: f64) -> f64 {
+        (time_s - self.crossing.time) / self.crossing.time.max(f64::MIN_POSITIVE)
+    }
+}
+
 /// `scene` with its frame cap lowered to `max_frames`, after checking that the bound's crossing fits under
 /// it: [`Error::FrameLimit`] names the frames needed and the limit. No run then goes past the limit: the
 /// memory of a run (and of every stage after it) grows with its frames.

@@ -1261,7 +1261,7 @@ mod tests {
         // before stopped at.
         let scene = staircase_scene(4);
         let settings = SearchSettings::for_quality(Quality::Fast);
-        let stages = with_planner(&scene, &settings, |planner, base, _| {
+        let (steps, stages) = with_planner(&scene, &settings, |planner, base, _| {
             let warm = planner.warm_start(base.seed());
             let n = warm.len();
             let planning = Relaxation::planning(planning_margin(planner));
@@ -1284,7 +1284,6 @@ mod tests {
             }
             (steps, stages)
         });
-        let (steps, stages) = stages;
         assert!(steps.len() >= 3, "{steps:?}");
         let tried: Vec<u32> = stages.iter().map(|s| s.0).collect();
         assert_eq!(tried, steps, "{stages:?}");

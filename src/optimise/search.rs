@@ -577,11 +577,6 @@ impl Finisher<'_> {
             "greedy",
         )
     }
-
-    /// The relative gap of a plan of `time_s` seconds to the bound.
-    fn gap(&self, time_s: f64) -> f64 {
-        (time_s - self.bound.crossing.time) / self.bound.crossing.time.max(f64::MIN_POSITIVE)
-    }
 }
 
 /// The solve of every entry point, at `settings` within `budget` (see [`solve_with_progress`]): the
@@ -727,7 +722,7 @@ fn airborne_outcome(
     let outcome = match found.best {
         Some((t, trace)) => {
             let status = stopped.unwrap_or(SearchStatus::Converged {
-                gap: finisher.gap(t),
+                gap: finisher.bound.gap(t),
             });
             finisher.outcome(trace.controls.clone(), trace, status, stats, "optimised")
         }
@@ -794,7 +789,7 @@ fn plan_jumping_scene(finisher: &Finisher, settings: &SearchSettings, budget: Bu
                 SearchStatus::stopped(&budget, Stage::Jumps)
             } else {
                 SearchStatus::Converged {
-                    gap: finisher.gap(t),
+                    gap: finisher.bound.gap(t),
                 }
             };
             return finisher.outcome(trace.controls.clone(), trace, status, stats, "optimised");
